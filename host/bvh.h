@@ -1,0 +1,45 @@
+// The bounding volume hierarchy: a binary tree built with the binned surface area
+// heuristic, collapsed into 8-wide nodes (kernels/types.h) for float8 traversal.
+#pragma once
+#include <cstddef>
+#include <vector>
+
+#include "../kernels/types.h"
+#include "scene.h"
+
+namespace fh {
+
+static_assert(sizeof(gpu::Bvh8Node) == 224, "Bvh8Node layout must match the device");
+static_assert(sizeof(gpu::CameraParams) == 80, "CameraParams layout must match the device");
+
+struct BvhStats {
+  size_t binaryNodes = 0;
+  size_t wideNodes = 0;
+  size_t leaves = 0;
+  int depth = 0;  // wide levels from the root to the deepest leaf
+  double buildSeconds = 0.0;
+};
+
+struct Bvh {
+  std::vector<gpu::Bvh8Node> nodes;
+  std::vector<float> triangles;  // 12 floats per triangle: v0.xyz id, v1.xyz 0, v2.xyz 0 (BVH order)
+  std::vector<unsigned> order;   // order[k]: the file-order id of the k-th triangle in BVH order
+  BvhStats stats;
+
+  size_t bytes() const { return nodes.size() * sizeof(gpu::Bvh8Node) + triangles.size() * sizeof(float); }
+  // Entries the traversal stack needs: each wide level pops one node and pushes up to 8.
+  int traversalStack() const { return 7 * stats.depth + 2; }
+};
+
+Bvh buildBvh(const Scene& scene);
+
+// Puts per-triangle data in BVH order: out[k] = in[order[k]] (stride values per triangle).
+template <typename T>
+std::vector<T> toBvhOrder(const std::vector<T>& in, const std::vector<unsigned>& order, size_t stride = 1) {
+  std::vector<T> out(order.size() * stride);
+  for (size_t k = 0; k < order.size(); ++k)
+    for (size_t j = 0; j < stride; ++j) out[k * stride + j] = in[order[k] * stride + j];
+  return out;
+}
+
+}  // namespace fh

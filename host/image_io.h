@@ -1,0 +1,32 @@
+// Writing the film through OpenImageIO. The format follows the extension: .exr as linear
+// float with the render settings in its metadata, .hdr/.pfm as float, .png/.jpg as sRGB
+// 8-bit. Row 0 is the top of the image.
+#pragma once
+#include <map>
+#include <string>
+#include <vector>
+
+namespace fh {
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<float> rgb;  // linear radiance, 3 floats per pixel, row-major from the top-left
+};
+
+enum class ImageEncoding { LinearFloat, Srgb8 };
+
+// Throws fh::Error (naming the flag) for an unknown extension, a missing or unwritable
+// directory, or an existing file without `force`. Call before rendering.
+ImageEncoding checkOutputPath(const std::string& path, bool force, const std::string& flag = "-o");
+
+// The first of base.ext, base-1.ext, base-2.ext ... that does not exist.
+std::string firstFreeName(const std::string& path);
+
+void writeImage(const std::string& path, const Image& image, const std::map<std::string, std::string>& metadata);
+
+Image readImage(const std::string& path);  // linear float RGB (tests)
+
+float linearToSrgb(float linear);
+float srgbToLinear(float encoded);
+
+}  // namespace fh

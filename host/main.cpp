@@ -1,0 +1,153 @@
+// The fredholm command line: `devices`, `render` and `bench`.
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <iostream>
+#include <sstream>
+
+#include "bvh.h"
+#include "devices.h"
+#include "error.h"
+#include "image_io.h"
+#include "render_aov.h"
+#include "scene_loader.h"
+
+namespace {
+
+using namespace fh;
+
+struct RenderOptions {
+  std::string scene;
+  std::string output;
+  bool force = false;
+  int width = 512, height = 512, spp = 4;
+  unsigned seed = 1;
+  std::string cameraFile, eye, target, up;
+  float fov = 0.f;
+  std::string aov = "albedo";
+  std::string device;
+};
+
+void printWarnings(const Scene& scene) {
+  for (const auto& w : scene.warnings) std::cerr << "fredholm: warning: " << w << "\n";
+}
+
+// --camera FILE, else the scene's sidecar, else framing; then --eye/--target/--up/--fov override.
+Camera chooseCamera(const RenderOptions& o, const Scene& scene) {
+  Camera camera;
+  if (!o.cameraFile.empty()) {
+    camera = loadCameraJson(o.cameraFile);
+  } else if (scene.hasCamera) {
+    camera = scene.camera;
+  } else {
+    Vec3f lo, hi;
+    scene.bounds(lo, hi);
+    camera = frameBounds(lo, hi);
+    if (o.eye.empty() || o.target.empty())
+      std::cerr << "fredholm: no camera given (--camera, --eye/--target, or a .camera.json beside the OBJ): "
+                   "framing the scene's bounds\n";
+  }
+  if (!o.eye.empty()) camera.eye = parseVec3Flag("--eye", o.eye);
+  if (!o.target.empty()) camera.target = parseVec3Flag("--target", o.target);
+  if (!o.up.empty()) camera.up = parseVec3Flag("--up", o.up);
+  if (o.fov != 0.f) camera.fovYDeg = o.fov;
+  validateCamera(camera, "camera");
+  return camera;
+}
+
+int runDevices(const std::string& spec) {
+  const auto all = listDevices();
+  std::cout << formatDeviceTable(spec.empty() ? all : selectDevices(all, spec));
+  return 0;
+}
+
+int runRender(RenderOptions o) {
+  const Aov aov = parseAov(o.aov);
+  if (o.width <= 0 || o.height <= 0) throw Error("--width/--height must be positive");
+  if (o.spp <= 0) throw Error("--spp must be positive");
+  // An explicit -o is never overwritten without --force; the default name steps aside.
+  if (o.output.empty()) o.output = firstFreeName("fredholm.png");
+  checkOutputPath(o.output, o.force);
+
+  const auto devices = selectDevices(listDevices(), o.device);
+  if (devices.size() > 1)
+    std::cerr << "fredholm: note: rendering on the first selected device (" << devices[0].name
+              << "); several devices per render come with multi-device support\n";
+
+  const Scene scene = o.scene.empty() ? loadDefaultScene() : loadScene(o.scene);
+  printWarnings(scene);
+  const Camera camera = chooseCamera(o, scene);
+  const auto start = std::chrono::steady_clock::now();
+  const Bvh bvh = buildBvh(scene);
+  DeviceContext dc(devices[0]);
+  AovSettings settings;
+  settings.width = o.width;
+  settings.height = o.height;
+  settings.spp = o.spp;
+  settings.seed = o.seed;
+  settings.mode = aov;
+  const Image image = renderAov(dc, scene, bvh, camera, settings);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  std::ostringstream time;
+  time << seconds;
+  writeImage(o.output, image,
+             {{"scene", scene.sourcePath}, {"spp", std::to_string(o.spp)}, {"method", "aov:" + o.aov},
+              {"device", devices[0].name}, {"seed", std::to_string(o.seed)}, {"seconds", time.str()}});
+  std::cerr << "fredholm: rendered " << scene.sourcePath << " (" << scene.triangleCount() << " triangles, "
+            << scene.lights.size() << " emissive) as " << o.aov << ", " << o.width << "x" << o.height << ", "
+            << o.spp << " spp on " << devices[0].name << " in " << time.str() << " s\n";
+  std::cout << "wrote " << o.output << "\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"fredholm: an OpenCL wavefront path tracer"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "fredholm " FREDHOLM_VERSION);
+
+  std::string devicesSpec;
+  auto* devices = app.add_subcommand("devices", "List OpenCL platforms and devices");
+  devices->add_option("--device", devicesSpec, "Show only the devices SPEC selects");
+
+  RenderOptions render;
+  auto* rendering = app.add_subcommand("render", "Render an OBJ scene (default: the built-in Cornell box)");
+  rendering->add_option("scene", render.scene, "OBJ file");
+  rendering->add_option("-o,--output", render.output,
+                        "Output image (.exr .hdr .pfm .png .jpg); default fredholm.png, or the next free "
+                        "fredholm-N.png");
+  rendering->add_flag("--force", render.force, "Overwrite an existing output file");
+  rendering->add_option("--width", render.width, "Image width in pixels")->capture_default_str();
+  rendering->add_option("--height", render.height, "Image height in pixels")->capture_default_str();
+  rendering->add_option("--spp", render.spp, "Samples per pixel")->capture_default_str();
+  rendering->add_option("--seed", render.seed, "Random seed")->capture_default_str();
+  rendering->add_option("--camera", render.cameraFile, "Camera JSON {eye,target,up,fov_y_deg}");
+  rendering->add_option("--eye", render.eye, "Camera position x,y,z");
+  rendering->add_option("--target", render.target, "Point the camera looks at x,y,z");
+  rendering->add_option("--up", render.up, "Camera up vector x,y,z");
+  rendering->add_option("--fov", render.fov, "Vertical field of view in degrees");
+  rendering->add_option("--aov", render.aov, "Debug output: albedo, normal or depth")->capture_default_str();
+  rendering->add_option("--device", render.device, "Device: index, list (0,1), type (cpu, gpu, all) or name");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    if (*devices) return runDevices(devicesSpec);
+    if (*rendering) return runRender(render);
+  } catch (const BuildError& e) {
+    std::cerr << "fredholm: error: " << e.what() << "\n";
+    return 1;
+  } catch (const Error& e) {
+    std::cerr << "fredholm: error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "fredholm: internal error: " << e.what() << "\n";
+    return 3;
+  }
+  return 0;
+}

@@ -1,0 +1,85 @@
+// The AOV pipeline: generate -> intersect -> shade_aov, one pass per sample.
+#include "render_aov.h"
+
+#include <algorithm>
+
+namespace fh {
+
+Aov parseAov(const std::string& name) {
+  if (name == "albedo") return Aov::Albedo;
+  if (name == "normal") return Aov::Normal;
+  if (name == "depth") return Aov::Depth;
+  throw Error("--aov '" + name + "': unknown output (use albedo, normal or depth)");
+}
+
+gpu::CameraParams makeCameraParams(const Camera& camera, int width, int height) {
+  const CameraFrame f = makeCameraFrame(camera, width, height);
+  gpu::CameraParams p{};
+  for (int k = 0; k < 3; ++k) {
+    p.origin[k] = f.origin[size_t(k)];
+    p.forward[k] = f.forward[size_t(k)];
+    p.right[k] = f.right[size_t(k)] * f.tanHalfFovY * f.aspect;
+    p.up[k] = f.up[size_t(k)] * f.tanHalfFovY;
+  }
+  p.width = width;
+  p.height = height;
+  return p;
+}
+
+Image renderAov(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const Camera& camera, const AovSettings& s) {
+  RayCaster caster(dc, bvh);
+  const cl::Program program = buildProgram(dc.context, dc.info.device, {"generate.cl", "aov.cl"}, "");
+  cl::Kernel generate = createKernel(program, "generate_camera_rays");
+  cl::Kernel shade = createKernel(program, "shade_aov");
+
+  const unsigned pixels = unsigned(s.width) * unsigned(s.height);
+  const auto& device = dc.info.device;
+  auto buffer = [&](size_t bytes, const char* what, const void* host = nullptr) {
+    return allocateBuffer(dc.context, device, host ? CL_MEM_READ_ONLY : CL_MEM_READ_WRITE, bytes, what, host);
+  };
+  cl::Buffer org = buffer(pixels * 16ull, "ray origins"), dir = buffer(pixels * 16ull, "ray directions");
+  cl::Buffer rayPixel = buffer(pixels * 4ull, "ray pixels"), hits = buffer(pixels * 16ull, "hits");
+  cl::Buffer film = buffer(pixels * 16ull, "film");
+  FH_CL(dc.queue.enqueueFillBuffer(film, 0.f, 0, pixels * 16ull));
+
+  const std::vector<int> triangleMaterial = toBvhOrder(scene.triangleMaterial, bvh.order);
+  std::vector<float> albedo;
+  for (const auto& m : scene.materials) albedo.insert(albedo.end(), {m.kd[0], m.kd[1], m.kd[2], 1.f});
+  cl::Buffer materialOf = buffer(triangleMaterial.size() * 4, "triangle materials", triangleMaterial.data());
+  cl::Buffer materialAlbedo = buffer(albedo.size() * 4, "material albedo", albedo.data());
+
+  const gpu::CameraParams cam = makeCameraParams(camera, s.width, s.height);
+  for (int sample = 0; sample < std::max(1, s.spp); ++sample) {
+    FH_CL(generate.setArg(0, sizeof cam, &cam));
+    FH_CL(generate.setArg(1, s.seed));
+    FH_CL(generate.setArg(2, unsigned(sample)));
+    FH_CL(generate.setArg(3, 0u));
+    FH_CL(generate.setArg(4, org));
+    FH_CL(generate.setArg(5, dir));
+    FH_CL(generate.setArg(6, rayPixel));
+    FH_CL(generate.setArg(7, pixels));
+    launch(dc, generate, pixels, "generate_camera_rays");
+    caster.intersectClosest(org, dir, hits, pixels);
+    FH_CL(shade.setArg(0, int(s.mode)));
+    FH_CL(shade.setArg(1, hits));
+    FH_CL(shade.setArg(2, rayPixel));
+    FH_CL(shade.setArg(3, caster.triangles()));
+    FH_CL(shade.setArg(4, materialOf));
+    FH_CL(shade.setArg(5, materialAlbedo));
+    FH_CL(shade.setArg(6, film));
+    FH_CL(shade.setArg(7, pixels));
+    launch(dc, shade, pixels, "shade_aov");
+  }
+  std::vector<float> sums(size_t(pixels) * 4);
+  FH_CL(dc.queue.enqueueReadBuffer(film, CL_TRUE, 0, sums.size() * 4, sums.data()));
+
+  Image image;
+  image.width = s.width;
+  image.height = s.height;
+  image.rgb.resize(size_t(pixels) * 3);
+  for (size_t p = 0; p < pixels; ++p)
+    for (size_t c = 0; c < 3; ++c) image.rgb[3 * p + c] = sums[4 * p + 3] > 0.f ? sums[4 * p + c] / sums[4 * p + 3] : 0.f;
+  return image;
+}
+
+}  // namespace fh

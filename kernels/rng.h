@@ -1,0 +1,22 @@
+// Counter-based random numbers: a hash of (pixel, sample, dimension) so any sample can
+// be regenerated independently of execution order (deterministic for a given seed).
+#ifndef FH_RNG_H
+#define FH_RNG_H
+
+// PCG-style 32-bit hash (a good avalanche for small, structured inputs).
+inline uint hash_u32(uint x) {
+  uint state = x * 747796405u + 2891336453u;
+  uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+  return (word >> 22u) ^ word;
+}
+
+inline uint hash_combine(uint a, uint b) { return hash_u32(a ^ (b + 0x9e3779b9u + (a << 6) + (a >> 2))); }
+
+// A float in [0, 1) from the top 24 bits.
+inline float u32_to_unit_float(uint x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
+
+inline float random_float(uint seed, uint stream, uint dimension) {
+  return u32_to_unit_float(hash_combine(hash_combine(seed, stream), dimension));
+}
+
+#endif

@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# One command from a fresh Debian 12 machine to a result:
+#   ./setup.sh render [fredholm render options...]   build, then render (default: the Cornell box)
+#   ./setup.sh test                                  build, then run the whole test suite
+#   ./setup.sh build                                 only install what is missing and build
+# Installs the Debian packages that are missing (needs root or sudo), configures and
+# builds into build/ (Release), and is quick when everything is already in place.
+set -euo pipefail
+cd "$(dirname "$0")"
+
+PACKAGES=(build-essential cmake ninja-build pkg-config
+          pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers clinfo
+          libopenimageio-dev openimageio-tools libtinyobjloader-dev libgtest-dev
+          libcli11-dev nlohmann-json3-dev)
+# Optional: Embree for the bench comparison, matplotlib for the charts.
+OPTIONAL_PACKAGES=(libembree-dev python3-matplotlib)
+
+missing_packages() {
+  local p
+  for p in "$@"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || echo "$p"
+  done
+}
+
+install_packages() {
+  local missing
+  missing=$(missing_packages "${PACKAGES[@]}" "${OPTIONAL_PACKAGES[@]}")
+  [ -z "$missing" ] && return 0
+  local sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  echo "setup: installing missing Debian packages:" $missing >&2
+  $sudo apt-get update -qq
+  # shellcheck disable=SC2086
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends $missing >&2
+}
+
+build() {
+  local generator=()
+  [ -f build/CMakeCache.txt ] || generator=(-G Ninja)
+  cmake -S . -B build "${generator[@]}" -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake --build build --parallel "$(nproc)"
+}
+
+action=${1:-build}
+[ $# -gt 0 ] && shift
+install_packages
+build
+case "$action" in
+  build) ;;
+  render) exec build/fredholm render "$@" ;;
+  test)
+    # PoCL's kernel cache and fredholm's program cache live in the build tree for tests,
+    # so a clean clone compiles each kernel once and reruns are fast.
+    export POCL_CACHE_DIR="$PWD/build/pocl-cache" FREDHOLM_CACHE_DIR="$PWD/build/program-cache"
+    exec ctest --test-dir build --output-on-failure --timeout 900 "$@" ;;
+  *) echo "setup.sh: unknown action '$action' (use: build, render, test)" >&2; exit 2 ;;
+esac
