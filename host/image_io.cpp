@@ -8,6 +8,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 #include "error.h"
 
@@ -20,6 +21,19 @@ std::string extensionOf(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   return ext;
+}
+
+// Debian 12's OpenImageIO (2.4) reads PFM but has no PFM writer, so fredholm writes it:
+// "PF", width height, a negative scale for little-endian, then rows bottom to top.
+void writePfm(const std::string& path, const Image& image) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw Error("cannot write '" + path + "'");
+  out << "PF\n" << image.width << " " << image.height << "\n-1.0\n";
+  static_assert(sizeof(float) == 4, "PFM stores 32-bit floats");
+  for (int y = image.height - 1; y >= 0; --y)
+    out.write(reinterpret_cast<const char*>(&image.rgb[size_t(y) * size_t(image.width) * 3]),
+              std::streamsize(size_t(image.width) * 3 * sizeof(float)));
+  if (!out) throw Error("cannot write '" + path + "': write failed");
 }
 
 }  // namespace
@@ -63,6 +77,7 @@ std::string firstFreeName(const std::string& path) {
 
 void writeImage(const std::string& path, const Image& image, const std::map<std::string, std::string>& metadata) {
   const ImageEncoding encoding = checkOutputPath(path, true);
+  if (extensionOf(path) == ".pfm") return writePfm(path, image);
   auto out = OIIO::ImageOutput::create(path);
   if (!out) throw Error("cannot write '" + path + "': " + OIIO::geterror());
   const bool isFloat = encoding == ImageEncoding::LinearFloat;

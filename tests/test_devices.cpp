@@ -1,0 +1,75 @@
+// Device listing and the --device grammar, on PoCL; the CLI's messages and exit codes.
+#include <gtest/gtest.h>
+
+#include "devices.h"
+#include "test_support.h"
+
+namespace fh {
+namespace {
+
+TEST(Devices, ListsAtLeastOneDeviceWithItsProperties) {
+  const auto all = listDevices();
+  ASSERT_FALSE(all.empty());
+  for (size_t i = 0; i < all.size(); ++i) {
+    EXPECT_EQ(all[i].index, int(i));
+    EXPECT_FALSE(all[i].name.empty());
+    EXPECT_GT(all[i].computeUnits, 0u);
+    EXPECT_GT(all[i].globalMemory, 0u);
+    EXPECT_NE(all[i].openclCVersion.find("OpenCL C"), std::string::npos);
+  }
+}
+
+TEST(Devices, SpecGrammar) {
+  const auto all = listDevices();
+  EXPECT_EQ(selectDevices(all, "").size(), 1u);
+  EXPECT_EQ(selectDevices(all, "all").size(), all.size());
+  EXPECT_EQ(selectDevices(all, "0").front().index, 0);
+  EXPECT_EQ(selectDevices(all, "0,0").size(), 1u);  // repeats collapse
+  EXPECT_EQ(selectDevices(all, all[0].type).front().type, all[0].type);
+  // A case-insensitive name substring.
+  std::string part = all[0].name.substr(0, 4);
+  for (char& c : part) c = char(std::toupper(static_cast<unsigned char>(c)));
+  EXPECT_EQ(selectDevices(all, part).front().index, 0);
+}
+
+TEST(Devices, SpecThatMatchesNothingSaysWhatExists) {
+  const auto all = listDevices();
+  try {
+    selectDevices(all, std::to_string(all.size() + 6));
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("no device with index"), std::string::npos) << msg;
+    EXPECT_NE(msg.find(all[0].name), std::string::npos) << msg;
+  }
+  EXPECT_THROW(selectDevices(all, "no-such-device-name"), Error);
+  EXPECT_THROW(selectDevices(all, "0,,1"), Error);
+}
+
+TEST(DevicesCli, TwoPoclDevices) {
+  const auto r = test::runFredholm("devices", "POCL_DEVICES='pthread pthread'");
+  EXPECT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("\n0 "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("\n1 "), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("\n2 "), std::string::npos) << r.output;
+}
+
+TEST(DevicesCli, UnknownIndexExitsNonZeroWithOneLine) {
+  const auto r = test::runFredholm("render --device 7 -o /tmp/fredholm-never-written.png", "POCL_DEVICES=pthread");
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_NE(r.output.find("fredholm: error: --device '7': no device with index 7; available: 0 = "),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+}
+
+TEST(DevicesCli, NoOpenClPlatformIsAClearError) {
+  // An empty vendor directory leaves the ICD loader with no platform at all.
+  const std::string dir = test::tempDir("icd");
+  const auto r = test::runFredholm("devices", "OCL_ICD_VENDORS=" + dir);
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_NE(r.output.find("fredholm: error: no OpenCL platform found"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace fh

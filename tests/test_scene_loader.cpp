@@ -1,0 +1,292 @@
+// Scene loading: every shared scene loads with the counts its README states, and every
+// bad input gives a clear error naming the file (and line) or a documented warning.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "error.h"
+#include "scene_loader.h"
+#include "test_support.h"
+
+namespace fh {
+namespace {
+
+using test::sharedScene;
+using test::writeFile;
+
+struct SceneCounts {
+  const char* path;
+  size_t triangles;
+  size_t emissiveTriangles;
+  size_t emissiveMaterials;
+};
+
+// Triangle counts from ../shared/scenes/README.md (tinyobjloader, n-gons as n-2
+// triangles). Emitters: each Cornell light and the Mori light is one quad (2 triangles);
+// the Glossy pair, bunny.obj, water.obj and Sponza have none; Veach has five sphere lights.
+const SceneCounts kSharedScenes[] = {
+    {"cornell-box/CornellBox-Original.obj", 36, 2, 1},
+    {"cornell-box/CornellBox-Mirror.obj", 36, 2, 1},
+    {"cornell-box/CornellBox-Empty-RG.obj", 12, 2, 1},
+    {"cornell-box/CornellBox-Empty-CO.obj", 12, 2, 1},
+    {"cornell-box/CornellBox-Empty-White.obj", 12, 2, 1},
+    {"cornell-box/CornellBox-Empty-Squashed.obj", 12, 2, 1},
+    {"cornell-box/CornellBox-Sphere.obj", 2188, 2, 1},
+    {"cornell-box/CornellBox-Water.obj", 7088, 2, 1},
+    {"cornell-box/CornellBox-Glossy.obj", 1112, 0, 0},
+    {"cornell-box/CornellBox-Glossy-Floor.obj", 1112, 0, 0},
+    {"cornell-box/water.obj", 4900, 0, 0},
+    {"cornell-box/legacy-glossy-2011/CornellBox-Glossy.obj", 1112, 2, 1},
+    {"bunny/bunny.obj", 69451, 0, 0},
+    {"bunny/CornellBox-Bunny.obj", 69463, 2, 1},
+    {"mori-knob/testObj.obj", 11970, 2, 1},
+    {"sponza/sponza.obj", 66450, 0, 0},
+    {"veach-mis/veach_mis.obj", 11052, size_t(-1), 5},
+};
+
+void PrintTo(const SceneCounts& c, std::ostream* os) { *os << c.path; }
+
+size_t emissiveMaterialsUsed(const Scene& scene) {
+  std::vector<bool> used(scene.materials.size(), false);
+  for (int m : scene.triangleMaterial) used[size_t(m)] = true;
+  size_t n = 0;
+  for (size_t m = 0; m < used.size(); ++m) n += used[m] && scene.materials[m].isEmissive();
+  return n;
+}
+
+class SharedScene : public ::testing::TestWithParam<SceneCounts> {};
+
+TEST_P(SharedScene, LoadsWithReadmeCounts) {
+  if (!test::haveSharedScenes()) GTEST_SKIP() << "../shared/scenes not present";
+  const SceneCounts& expected = GetParam();
+  const Scene scene = loadScene(sharedScene(expected.path));
+  EXPECT_EQ(scene.triangleCount(), expected.triangles);
+  if (expected.emissiveTriangles != size_t(-1)) {
+    EXPECT_EQ(scene.lights.size(), expected.emissiveTriangles);
+  }
+  EXPECT_EQ(emissiveMaterialsUsed(scene), expected.emissiveMaterials);
+  EXPECT_EQ(scene.triangleMaterial.size(), scene.triangleCount());
+  for (unsigned i : scene.indices) ASSERT_LT(i, scene.vertexCount());
+  for (float p : scene.positions) ASSERT_TRUE(std::isfinite(p));
+  if (!scene.cornerNormals.empty()) {
+    EXPECT_EQ(scene.cornerNormals.size(), 9 * scene.triangleCount());
+  }
+  if (!scene.cornerUVs.empty()) {
+    EXPECT_EQ(scene.cornerUVs.size(), 6 * scene.triangleCount());
+  }
+  for (const Light& l : scene.lights) EXPECT_GT(l.area, 0.f);
+}
+
+std::string sceneName(const ::testing::TestParamInfo<SceneCounts>& info) {
+  std::string name = std::filesystem::path(info.param.path).stem().string();
+  if (std::string(info.param.path).find("legacy") != std::string::npos) name = "Legacy" + name;
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  return name;
+}
+
+INSTANTIATE_TEST_SUITE_P(Corpus, SharedScene, ::testing::ValuesIn(kSharedScenes), sceneName);
+
+TEST(SceneLoader, CornellLightAndMaterialsAsInMtl) {
+  const Scene scene = loadDefaultScene();
+  EXPECT_EQ(scene.triangleCount(), 36u);
+  ASSERT_EQ(scene.lights.size(), 2u);
+  const Material& light = scene.materials[size_t(scene.triangleMaterial[scene.lights[0].triangle])];
+  EXPECT_EQ(light.ke, (Vec3f{17.f, 12.f, 4.f}));
+  // The light quad's area: 0.47 x 0.38 at y = 1.98 (two triangles share it).
+  EXPECT_NEAR(scene.lights[0].area + scene.lights[1].area, 0.47f * 0.38f, 2e-3f);
+  // Tf 1 1 1 on an opaque material means nothing.
+  EXPECT_EQ(light.tf, (Vec3f{0.f, 0.f, 0.f}));
+  EXPECT_TRUE(scene.hasCamera);
+  EXPECT_FLOAT_EQ(scene.camera.fovYDeg, 39.3f);
+}
+
+TEST(SceneLoader, GlossyArchiveMissingLightMaterialWarnsAndUsesDefault) {
+  if (!test::haveSharedScenes()) GTEST_SKIP() << "../shared/scenes not present";
+  const Scene scene = loadScene(sharedScene("cornell-box/CornellBox-Glossy.obj"));
+  bool warned = false;
+  for (const auto& w : scene.warnings) warned |= w.find("'light' is not defined") != std::string::npos;
+  EXPECT_TRUE(warned);
+  EXPECT_EQ(scene.materials.back().name, "default");
+}
+
+TEST(SceneLoader, SponzaTexturesResolveCaseInsensitively) {
+  if (!test::haveSharedScenes()) GTEST_SKIP() << "../shared/scenes not present";
+  const Scene scene = loadScene(sharedScene("sponza/sponza.obj"));
+  EXPECT_EQ(scene.textures.size(), 12u);  // 19 materials use map_Kd: 12 distinct files
+  for (const auto& w : scene.warnings) EXPECT_EQ(w.find("texture"), std::string::npos) << w;
+  for (const auto& t : scene.textures) EXPECT_TRUE(std::filesystem::exists(t.path)) << t.path;
+  EXPECT_FALSE(scene.cornerUVs.empty());
+}
+
+TEST(SceneLoader, SmoothNormalsKeptOnlyWhereTheFileHasThem) {
+  if (!test::haveSharedScenes()) GTEST_SKIP() << "../shared/scenes not present";
+  EXPECT_FALSE(loadScene(sharedScene("cornell-box/CornellBox-Sphere.obj")).cornerNormals.empty());
+  EXPECT_TRUE(loadScene(sharedScene("cornell-box/CornellBox-Original.obj")).cornerNormals.empty());
+}
+
+// ---- Small scenes written by the tests ----
+
+class BadInput : public ::testing::Test {
+ protected:
+  std::string dir = test::tempDir("loader");
+  std::string path(const std::string& name) const { return dir + "/" + name; }
+
+  // Loads `obj` (written to scene.obj) and returns the error message, or "" if it loaded.
+  std::string errorFor(const std::string& obj, const std::string& mtl = "") {
+    writeFile(path("scene.obj"), obj);
+    if (!mtl.empty()) writeFile(path("scene.mtl"), mtl);
+    try {
+      loadScene(path("scene.obj"));
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "";
+  }
+};
+
+const char* kTriangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+
+TEST_F(BadInput, MissingFile) {
+  try {
+    loadScene(path("nothing.obj"));
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("nothing.obj: OBJ file not found"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(BadInput, DirectoryInsteadOfFile) {
+  std::filesystem::create_directory(path("dir.obj"));
+  try {
+    loadScene(path("dir.obj"));
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(BadInput, EmptyFile) {
+  EXPECT_NE(errorFor("").find("scene.obj: no faces"), std::string::npos);
+}
+
+TEST_F(BadInput, OnlyComments) {
+  EXPECT_NE(errorFor("# nothing here\n\n").find("no faces"), std::string::npos);
+}
+
+TEST_F(BadInput, NaNVertex) {
+  EXPECT_NE(errorFor("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n").find("scene.obj:2: non-finite value 'nan'"),
+            std::string::npos);
+}
+
+TEST_F(BadInput, InfiniteVertex) {
+  EXPECT_NE(errorFor("v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n").find("scene.obj:3: non-finite"), std::string::npos);
+  // Finite in the file but not as a float.
+  EXPECT_NE(errorFor("v 0 0 0\nv 1e40 0 0\nv 0 1 0\nf 1 2 3\n").find("scene.obj:2: non-finite"), std::string::npos);
+}
+
+TEST_F(BadInput, MalformedVertex) {
+  EXPECT_NE(errorFor("v 0 0 0\nv 1 abc 0\nv 0 1 0\nf 1 2 3\n").find("scene.obj:2: 'abc' is not a number"),
+            std::string::npos);
+  EXPECT_NE(errorFor("v 0 0\n").find("scene.obj:1: 'v' needs 3 to 7 numbers"), std::string::npos);
+}
+
+TEST_F(BadInput, MalformedFaces) {
+  EXPECT_NE(errorFor(std::string(kTriangle) + "f 1 2\n").find("scene.obj:4: face needs at least three"),
+            std::string::npos);
+  EXPECT_NE(errorFor(std::string(kTriangle) + "f 1/x 2 3\n").find("scene.obj:4: face element '1/x'"),
+            std::string::npos);
+  EXPECT_NE(errorFor(std::string(kTriangle) + "f 0 1 2\n").find("scene.obj:4: face element '0' uses index 0"),
+            std::string::npos);
+  EXPECT_NE(errorFor(std::string(kTriangle) + "f 1/2/3/4 2 3\n").find("scene.obj:4:"), std::string::npos);
+}
+
+TEST_F(BadInput, IndicesOutOfRange) {
+  EXPECT_NE(errorFor(std::string(kTriangle) + "f 1 2 9\n").find("scene.obj:4: vertex index 9 out of range"),
+            std::string::npos);
+  EXPECT_NE(errorFor(std::string(kTriangle) + "f -5 -2 -1\n")
+                .find("scene.obj:4: relative vertex index -5 out of range (3 defined so far)"),
+            std::string::npos);
+  EXPECT_NE(errorFor(std::string(kTriangle) + "vn 0 0 1\nf 1//1 2//2 3//1\n").find("scene.obj:5: normal index 2"),
+            std::string::npos);
+}
+
+TEST_F(BadInput, MissingMtl) {
+  EXPECT_NE(errorFor(std::string("mtllib gone.mtl\n") + kTriangle + "f 1 2 3\n")
+                .find("scene.obj:1: material library 'gone.mtl' not found"),
+            std::string::npos);
+}
+
+TEST_F(BadInput, MtlIsADirectory) {
+  std::filesystem::create_directory(path("lib.mtl"));
+  EXPECT_NE(errorFor(std::string("mtllib lib.mtl\n") + kTriangle + "f 1 2 3\n").find("is a directory"),
+            std::string::npos);
+}
+
+TEST_F(BadInput, MalformedMtl) {
+  const std::string obj = std::string("mtllib scene.mtl\n") + kTriangle + "usemtl a\nf 1 2 3\n";
+  EXPECT_NE(errorFor(obj, "newmtl a\nKd 0.5 abc 0.5\n").find("scene.mtl:2: 'abc' is not a number in 'Kd'"),
+            std::string::npos);
+  EXPECT_NE(errorFor(obj, "newmtl a\nKe nan 1 1\n").find("scene.mtl:2: non-finite value"), std::string::npos);
+  EXPECT_NE(errorFor(obj, "Kd 1 1 1\nnewmtl a\n").find("scene.mtl:1: 'Kd' before any 'newmtl'"),
+            std::string::npos);
+  EXPECT_NE(errorFor(obj, "newmtl a\nillum\n").find("scene.mtl:2: 'illum' needs 1 numbers"), std::string::npos);
+}
+
+TEST_F(BadInput, ZeroByteMtlWarnsAndUsesDefaultMaterial) {
+  writeFile(path("scene.mtl"), "");
+  writeFile(path("scene.obj"), std::string("mtllib scene.mtl\n") + kTriangle + "usemtl red\nf 1 2 3\n");
+  const Scene scene = loadScene(path("scene.obj"));
+  ASSERT_FALSE(scene.warnings.empty());
+  EXPECT_NE(scene.warnings[0].find("scene.obj:5: material 'red' is not defined"), std::string::npos)
+      << scene.warnings[0];
+  EXPECT_EQ(scene.materials[size_t(scene.triangleMaterial[0])].name, "default");
+}
+
+TEST_F(BadInput, MissingTextureWarnsAndFallsBackToKd) {
+  writeFile(path("scene.mtl"), "newmtl t\nKd 0.2 0.3 0.4\nmap_Kd nowhere.png\n");
+  writeFile(path("scene.obj"), std::string("mtllib scene.mtl\n") + kTriangle + "usemtl t\nf 1 2 3\n");
+  const Scene scene = loadScene(path("scene.obj"));
+  bool warned = false;
+  for (const auto& w : scene.warnings) warned |= w.find("texture 'nowhere.png' not found") != std::string::npos;
+  EXPECT_TRUE(warned);
+  EXPECT_EQ(scene.materials[0].kdTexture, -1);
+}
+
+TEST_F(BadInput, FaceWithoutMaterialGetsDefaultGreyAndWarning) {
+  writeFile(path("scene.obj"), std::string(kTriangle) + "f 1 2 3\n");
+  const Scene scene = loadScene(path("scene.obj"));
+  EXPECT_EQ(scene.materials[size_t(scene.triangleMaterial[0])].kd, (Vec3f{0.5f, 0.5f, 0.5f}));
+  bool warned = false;
+  for (const auto& w : scene.warnings) warned |= w.find("no material") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+TEST_F(BadInput, BinaryGarbage) {
+  std::string garbage;
+  for (int i = 0; i < 4096; ++i) garbage.push_back(char((i * 7919) % 256));
+  EXPECT_NE(errorFor(garbage).find("scene.obj"), std::string::npos);
+}
+
+TEST_F(BadInput, CliReportsOneLineAndFails) {
+  writeFile(path("bad.obj"), "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
+  const auto r = test::runFredholm("render " + path("bad.obj") + " -o " + path("out.png"));
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_NE(r.output.find("fredholm: error: " + path("bad.obj") + ":2: non-finite value 'nan'"), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(std::filesystem::exists(path("out.png")));
+}
+
+TEST(SceneLoader, NgonsNegativeIndicesAndCrlf) {
+  const std::string dir = test::tempDir("ngon");
+  // A pentagon (3 triangles) with relative indices and CRLF line ends.
+  writeFile(dir + "/p.obj",
+            "v 0 0 0\r\nv 1 0 0\r\nv 1.5 1 0\r\nv 0.5 1.5 0\r\nv -0.5 1 0\r\nf -5 -4 -3 -2 -1\r\n");
+  const Scene scene = loadScene(dir + "/p.obj");
+  EXPECT_EQ(scene.triangleCount(), 3u);
+  for (unsigned i : scene.indices) EXPECT_LT(i, 5u);
+}
+
+}  // namespace
+}  // namespace fh

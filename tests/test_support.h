@@ -1,0 +1,38 @@
+// Helpers shared by the tests: paths, temporary directories, running the CLI.
+#pragma once
+#include <cmath>
+#include <string>
+
+namespace fh::test {
+
+// Absolute path of a file in ../shared/scenes, or "" if the corpus is absent.
+std::string sharedScene(const std::string& relative);
+bool haveSharedScenes();
+
+// A fresh empty directory under the system temp dir, removed at exit.
+std::string tempDir(const std::string& tag);
+void writeFile(const std::string& path, const std::string& text);
+
+struct CommandResult {
+  int exitCode = -1;
+  std::string output;  // stdout and stderr together
+};
+// Runs the fredholm binary with `args` (a shell-quoted string) and optional environment prefix.
+CommandResult runFredholm(const std::string& args, const std::string& env = "");
+
+}  // namespace fh::test
+
+#include "scene.h"
+
+namespace fh::test {
+
+// Closest hit by testing every triangle (double-precision Moller-Trumbore): the
+// reference the device kernels are compared with. triangle is -1 on a miss.
+struct BruteHit {
+  double t = INFINITY;
+  long triangle = -1;
+};
+BruteHit bruteForceClosest(const Scene& scene, const double org[3], const double dir[3], double tMin = 0.0,
+                           double tMax = INFINITY);
+
+}  // namespace fh::test
