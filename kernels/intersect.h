@@ -6,6 +6,11 @@
 
 #include "types.h"
 
+// Watertightness needs the edge functions of two triangles that share an edge to be
+// exact negatives of each other; a fused multiply-add would round one product and not
+// the other, opening cracks along shared edges.
+#pragma OPENCL FP_CONTRACT OFF
+
 // The host passes the stack depth its BVH needs (7 per wide level + 1) as a build option.
 #ifndef FH_TRAVERSAL_STACK
 #define FH_TRAVERSAL_STACK 64

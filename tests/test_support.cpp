@@ -3,6 +3,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -64,28 +65,111 @@ CommandResult runFredholm(const std::string& args, const std::string& env) {
 
 namespace fh::test {
 
+namespace {
+
+struct D3 {
+  double x, y, z;
+};
+D3 operator-(D3 a, D3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+D3 operator+(D3 a, D3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+D3 operator*(D3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+double dotd(D3 a, D3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+D3 crossd(D3 a, D3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+double maxAbs(D3 a) { return std::max({std::fabs(a.x), std::fabs(a.y), std::fabs(a.z)}); }
+
+D3 cornerD(const Scene& s, size_t t, int k) {
+  const Vec3f p = s.corner(t, k);
+  return {p[0], p[1], p[2]};
+}
+
+// Distance from the ray's line to segment (a, b), measured in the plane across the ray.
+double distanceToEdge(D3 o, D3 dUnit, D3 a, D3 b) {
+  auto project = [&](D3 p) { return (p - o) - dUnit * dotd(p - o, dUnit); };
+  const D3 pa = project(a), pb = project(b), e = pb - pa;
+  const double len2 = dotd(e, e);
+  const double s = len2 > 0.0 ? std::clamp(-dotd(pa, e) / len2, 0.0, 1.0) : 0.0;
+  const D3 closest = pa + e * s;
+  return std::sqrt(dotd(closest, closest));
+}
+
+}  // namespace
+
+double rayTriangle(const Scene& scene, size_t t, const double o[3], const double d[3]) {
+  const D3 v0 = cornerD(scene, t, 0), v1 = cornerD(scene, t, 1), v2 = cornerD(scene, t, 2);
+  const D3 dir{d[0], d[1], d[2]}, org{o[0], o[1], o[2]};
+  const D3 e1 = v1 - v0, e2 = v2 - v0, p = crossd(dir, e2);
+  const double det = dotd(e1, p);
+  if (det == 0.0) return INFINITY;
+  const D3 s = org - v0, q = crossd(s, e1);
+  const double u = dotd(s, p) / det, w = dotd(dir, q) / det;
+  if (u < 0.0 || w < 0.0 || u + w > 1.0) return INFINITY;
+  return dotd(e2, q) / det;
+}
+
+double floatEdgeMargin(const Scene& scene, size_t t, const double o[3]) {
+  const D3 org{o[0], o[1], o[2]};
+  double reach = 0.0, size = maxAbs(org);
+  for (int k = 0; k < 3; ++k) {
+    reach = std::max(reach, maxAbs(cornerD(scene, t, k) - org));
+    size = std::max(size, maxAbs(cornerD(scene, t, k)));
+  }
+  return std::ldexp(reach + size, -18);
+}
+
+double rayTriangleWithMargin(const Scene& scene, size_t t, const double o[3], const double d[3], double margin) {
+  const double exact = rayTriangle(scene, t, o, d);
+  if (margin == 0.0) return exact;
+  const D3 v[3] = {cornerD(scene, t, 0), cornerD(scene, t, 1), cornerD(scene, t, 2)};
+  const D3 org{o[0], o[1], o[2]}, dir{d[0], d[1], d[2]};
+  const D3 dUnit = dir * (1.0 / std::sqrt(dotd(dir, dir)));
+  double nearest = INFINITY;
+  int nearestEdge = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double dist = distanceToEdge(org, dUnit, v[k], v[(k + 1) % 3]);
+    if (dist < nearest) {
+      nearest = dist;
+      nearestEdge = k;
+    }
+  }
+  const bool nearEdge = nearest < std::fabs(margin);
+  if (margin < 0.0) return nearEdge ? INFINITY : exact;
+  if (exact != INFINITY || !nearEdge) return exact;
+  // Grown and passing near an edge: the distance to the plane, or along the ray to the
+  // edge's midpoint where the ray is parallel to the plane.
+  const D3 n = crossd(v[1] - v[0], v[2] - v[0]);
+  const double denom = dotd(n, dir);
+  const D3 mid = (v[nearestEdge] + v[(nearestEdge + 1) % 3]) * 0.5;
+  if (denom != 0.0) return dotd(n, v[0] - org) / denom;
+  return dotd(mid - org, dir) / dotd(dir, dir);
+}
+
+BruteHits bruteForceBands(const Scene& scene, const double o[3], const double d[3], double tMin, double tMax) {
+  BruteHits h;
+  h.exact.t = h.grown.t = h.shrunk.t = tMax;
+  auto consider = [&](BruteHit& best, double t, size_t tri) {
+    if (t >= tMin && t < best.t) {
+      best.t = t;
+      best.triangle = long(tri);
+    }
+  };
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    const double margin = floatEdgeMargin(scene, t, o);
+    const double grown = rayTriangleWithMargin(scene, t, o, d, margin);
+    if (grown == INFINITY) continue;  // outside the grown triangle: outside the others too
+    consider(h.grown, grown, t);
+    consider(h.exact, rayTriangle(scene, t, o, d), t);
+    consider(h.shrunk, rayTriangleWithMargin(scene, t, o, d, -margin), t);
+  }
+  for (BruteHit* b : {&h.exact, &h.grown, &h.shrunk})
+    if (b->triangle < 0) b->t = INFINITY;
+  return h;
+}
+
 BruteHit bruteForceClosest(const Scene& scene, const double o[3], const double d[3], double tMin, double tMax) {
   BruteHit best;
   best.t = tMax;
   for (size_t t = 0; t < scene.triangleCount(); ++t) {
-    double v[3][3];
-    for (int k = 0; k < 3; ++k) {
-      const Vec3f p = scene.corner(t, k);
-      for (int j = 0; j < 3; ++j) v[k][j] = p[size_t(j)];
-    }
-    const double e1[3] = {v[1][0] - v[0][0], v[1][1] - v[0][1], v[1][2] - v[0][2]};
-    const double e2[3] = {v[2][0] - v[0][0], v[2][1] - v[0][1], v[2][2] - v[0][2]};
-    const double p[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2], d[0] * e2[1] - d[1] * e2[0]};
-    const double det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
-    if (det == 0.0) continue;
-    const double inv = 1.0 / det;
-    const double s[3] = {o[0] - v[0][0], o[1] - v[0][1], o[2] - v[0][2]};
-    const double u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) * inv;
-    if (u < 0.0 || u > 1.0) continue;
-    const double q[3] = {s[1] * e1[2] - s[2] * e1[1], s[2] * e1[0] - s[0] * e1[2], s[0] * e1[1] - s[1] * e1[0]};
-    const double w = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) * inv;
-    if (w < 0.0 || u + w > 1.0) continue;
-    const double dist = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) * inv;
+    const double dist = rayTriangle(scene, t, o, d);
     if (dist >= tMin && dist < best.t) {
       best.t = dist;
       best.triangle = long(t);

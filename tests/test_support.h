@@ -35,4 +35,25 @@ struct BruteHit {
 BruteHit bruteForceClosest(const Scene& scene, const double org[3], const double dir[3], double tMin = 0.0,
                            double tMax = INFINITY);
 
+// Ray/triangle distance in double precision (Moller-Trumbore); INFINITY on a miss.
+double rayTriangle(const Scene& scene, size_t triangle, const double org[3], const double dir[3]);
+
+// The same with the triangle grown (margin > 0) or shrunk (margin < 0) by |margin|,
+// a distance measured across the ray: the ray counts as hitting the grown triangle when
+// it passes within `margin` of one of its edges.
+double rayTriangleWithMargin(const Scene& scene, size_t triangle, const double org[3], const double dir[3],
+                             double margin);
+
+// How far a float ray/triangle test may misjudge the ray's distance to an edge: a few
+// dozen ulps of the magnitudes it subtracts (vertex - origin, then the shear).
+double floatEdgeMargin(const Scene& scene, size_t triangle, const double org[3]);
+
+// The closest hit in [tMin, tMax) of three oracles at once: triangles as they are, grown
+// and shrunk by floatEdgeMargin. A correct float kernel's answer lies between shrunk and
+// grown.
+struct BruteHits {
+  BruteHit exact, grown, shrunk;
+};
+BruteHits bruteForceBands(const Scene& scene, const double org[3], const double dir[3], double tMin, double tMax);
+
 }  // namespace fh::test

@@ -1,0 +1,391 @@
+// The intersect kernels against a brute-force double-precision reference on the same
+// rays, for every shared scene and ray kind; watertightness on shared edges and vertices
+// of closed meshes; and no self-intersection of spawned rays at any scene scale.
+//
+// The oracle: triangles grown and shrunk by the error a float test may make in the ray's
+// distance to an edge (2^-18 of the magnitudes involved, see floatEdgeMargin) bracket
+// every answer a correct kernel may give. A closest hit must be a triangle of the grown
+// set at the reference distance (within 1e-5 of the magnitudes, divided by the cosine
+// to the plane), with nothing of the shrunk set closer; a miss must miss the shrunk set.
+// So hits and misses agree except within that margin of an edge, t agrees tightly, and
+// the triangle agrees unless two are tied.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <future>
+#include <random>
+
+#include "bvh.h"
+#include "ray_workload.h"
+#include "scene_loader.h"
+#include "test_support.h"
+#include "vec.h"
+
+namespace fh {
+namespace {
+
+struct Rays {
+  std::vector<float> org, dir;  // float4 each
+  void add(const float3& o, const float3& d, float tMin = 0.f, float tMax = INFINITY) {
+    org.insert(org.end(), {o[0], o[1], o[2], tMin});
+    dir.insert(dir.end(), {d[0], d[1], d[2], tMax});
+  }
+  size_t size() const { return org.size() / 4; }
+};
+
+double magnitude(const float* o4) { return std::max({std::fabs(o4[0]), std::fabs(o4[1]), std::fabs(o4[2])}); }
+
+// Allowed |t_device - t_reference| for a ray from `org` hitting `triangle`: the float
+// error of the point, divided by the cosine to the plane (t of a grazing ray is
+// ill-conditioned: a small error across the plane is a long way along the ray).
+double tTolerance(const Scene& scene, size_t triangle, const float* org, const float* dir, double t) {
+  const float3 n = cross(scene.corner(triangle, 1) - scene.corner(triangle, 0),
+                         scene.corner(triangle, 2) - scene.corner(triangle, 0));
+  const float3 d{dir[0], dir[1], dir[2]};
+  const double cosine = length(n) > 0.f ? std::fabs(dot(normalize(n), normalize(d))) : 1.0;
+  return 1e-5 * (magnitude(org) + t) / std::max(cosine, 1e-4) + 1e-30;
+}
+
+struct Mismatch {
+  size_t ray;
+  std::string what;
+};
+
+// Checks closest hits (BVH-order triangle ids mapped to file order) and any-hit answers.
+std::vector<Mismatch> checkRays(const Scene& scene, const Bvh& bvh, const Rays& rays, const std::vector<float>& hits,
+                                const std::vector<int>& occluded, size_t first, size_t last) {
+  std::vector<Mismatch> bad;
+  for (size_t i = first; i < last; ++i) {
+    const float* o = &rays.org[4 * i];
+    const float* d = &rays.dir[4 * i];
+    const double org[3] = {o[0], o[1], o[2]}, dir[3] = {d[0], d[1], d[2]};
+    const test::BruteHits ref = test::bruteForceBands(scene, org, dir, o[3], d[3]);
+    const float t = hits[4 * i];
+    int bvhTri;
+    std::memcpy(&bvhTri, &hits[4 * i + 3], 4);
+    std::ostringstream why;
+    if (bvhTri < 0) {
+      if (ref.shrunk.triangle >= 0) why << "device missed; reference hits triangle " << ref.shrunk.triangle << " at t=" << ref.shrunk.t;
+    } else {
+      const size_t tri = bvh.order[size_t(bvhTri)];
+      const double tRef = test::rayTriangleWithMargin(scene, tri, org, dir, test::floatEdgeMargin(scene, tri, org));
+      const double tol = tTolerance(scene, tri, o, d, tRef);
+      if (!(std::fabs(t - tRef) <= tol))
+        why << "device hit triangle " << tri << " at t=" << t << ", reference t for it " << tRef;
+      else if (ref.shrunk.t < t - tol)
+        why << "device hit triangle " << tri << " at t=" << t << " but triangle " << ref.shrunk.triangle
+            << " is closer at " << ref.shrunk.t;
+    }
+    const bool mustBeOccluded = ref.shrunk.triangle >= 0, mayBeOccluded = ref.grown.triangle >= 0;
+    if (occluded[i] && !mayBeOccluded) why << " any-hit says occluded, reference sees nothing";
+    if (!occluded[i] && mustBeOccluded) why << " any-hit says free, reference hits " << ref.shrunk.triangle;
+    if (!why.str().empty()) {
+      why << " [org " << o[0] << " " << o[1] << " " << o[2] << " dir " << d[0] << " " << d[1] << " " << d[2] << "]";
+      bad.push_back({i, why.str()});
+    }
+  }
+  return bad;
+}
+
+class RayCasting {
+ public:
+  explicit RayCasting(const Scene& s) : scene(s), bvh(buildBvh(s)), caster(dc, bvh), work(dc, s, bvh, caster) {}
+
+  // Traces `rays` with both kernels and checks every ray against the reference on two threads.
+  void expectMatchesReference(const Rays& rays, const std::string& kind) {
+    RayQueue q = work.upload(rays.org, rays.dir);
+    const cl::Buffer hitBuffer = work.closestHits(q);
+    cl::Buffer occludedBuffer =
+        allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, q.count * 4ull + 4, "occluded");
+    caster.intersectAny(q.org, q.dir, occludedBuffer, q.count);
+    const std::vector<float> hits = work.readFloat4(hitBuffer, q.count);
+    std::vector<int> occluded(q.count);
+    FH_CL(dc.queue.enqueueReadBuffer(occludedBuffer, CL_TRUE, 0, q.count * 4ull, occluded.data()));
+
+    const size_t half = rays.size() / 2;
+    auto second = std::async(std::launch::async, checkRays, std::cref(scene), std::cref(bvh), std::cref(rays),
+                             std::cref(hits), std::cref(occluded), half, rays.size());
+    std::vector<Mismatch> bad = checkRays(scene, bvh, rays, hits, occluded, 0, half);
+    for (auto& m : second.get()) bad.push_back(m);
+    size_t hitsSeen = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      int tri;
+      std::memcpy(&tri, &hits[4 * i + 3], 4);
+      hitsSeen += tri >= 0;
+    }
+    EXPECT_TRUE(bad.empty()) << kind << ": " << bad.size() << " of " << rays.size() << " rays disagree; first: ray "
+                             << (bad.empty() ? 0 : bad[0].ray) << ": " << (bad.empty() ? "" : bad[0].what);
+    lastHitFraction = double(hitsSeen) / double(std::max<size_t>(1, rays.size()));
+  }
+
+  Rays download(const RayQueue& q) {
+    Rays r;
+    r.org = work.readFloat4(q.org, q.count);
+    r.dir = work.readFloat4(q.dir, q.count);
+    return r;
+  }
+
+  const Scene& scene;
+  Bvh bvh;
+  DeviceContext dc{selectDevices(listDevices(), "").front()};
+  RayCaster caster;
+  RayWorkload work;
+  double lastHitFraction = 0.0;
+};
+
+float3 randomDirection(std::mt19937& rng) {
+  std::normal_distribution<float> n;
+  return normalize(float3{n(rng), n(rng), n(rng)});
+}
+
+float3 pointOnTriangle(const Scene& s, size_t t, float b1, float b2) {
+  return s.corner(t, 0) * (1.f - b1 - b2) + s.corner(t, 1) * b1 + s.corner(t, 2) * b2;
+}
+
+struct SceneBox {
+  float3 lo, hi;
+  float3 random(std::mt19937& rng) const {
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    return {lo[0] + u(rng) * (hi[0] - lo[0]), lo[1] + u(rng) * (hi[1] - lo[1]), lo[2] + u(rng) * (hi[2] - lo[2])};
+  }
+};
+
+SceneBox expandedBounds(const Scene& s) {
+  SceneBox b;
+  s.bounds(b.lo, b.hi);
+  const float3 margin = (b.hi - b.lo) * 0.25f;
+  b.lo = b.lo - margin;
+  b.hi = b.hi + margin;
+  return b;
+}
+
+// Every ray kind built on the host: incoherent, grazing, through vertices, along edges.
+std::map<std::string, Rays> hostRays(const Scene& s, size_t n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  std::uniform_int_distribution<size_t> pick(0, s.triangleCount() - 1);
+  const SceneBox box = expandedBounds(s);
+  std::map<std::string, Rays> kinds;
+  for (size_t i = 0; i < n; ++i) {
+    kinds["incoherent"].add(box.random(rng), randomDirection(rng));
+
+    // Grazing: nearly parallel to a triangle's plane, aimed inside it.
+    const size_t t = pick(rng);
+    const float3 e1 = s.corner(t, 1) - s.corner(t, 0), e2 = s.corner(t, 2) - s.corner(t, 0);
+    const float3 nrm = cross(e1, e2);
+    if (length(nrm) > 0.f) {
+      const float3 normal = normalize(nrm), inPlane = normalize(e1 * (u(rng) - 0.5f) + e2 * (u(rng) - 0.5f));
+      const float3 d = normalize(inPlane + normal * ((u(rng) - 0.5f) * 2e-3f));
+      const float su = std::sqrt(u(rng));
+      const float3 target = pointOnTriangle(s, t, su * u(rng), 1.f - su);
+      const float reach = length(box.hi - box.lo);
+      kinds["grazing"].add(target - d * (0.5f * reach), d);
+    }
+
+    // Exactly through a vertex, and through a point on an edge.
+    const float3 vertex = s.corner(pick(rng), int(i % 3));
+    const float3 from = box.random(rng);
+    if (length(vertex - from) > 0.f) kinds["vertices"].add(from, normalize(vertex - from));
+    const size_t te = pick(rng);
+    const int k = int(i % 3);
+    const float a = u(rng);
+    const float3 onEdge = s.corner(te, k) * (1.f - a) + s.corner(te, (k + 1) % 3) * a;
+    const float3 from2 = box.random(rng);
+    if (length(onEdge - from2) > 0.f) kinds["edges"].add(from2, normalize(onEdge - from2));
+  }
+  return kinds;
+}
+
+struct ScenePath {
+  const char* path;
+  size_t raysPerKind;
+};
+
+class AgainstBruteForce : public ::testing::TestWithParam<ScenePath> {};
+
+void PrintTo(const ScenePath& p, std::ostream* os) { *os << p.path; }
+
+TEST_P(AgainstBruteForce, EveryRayKindAgrees) {
+  if (!test::haveSharedScenes()) GTEST_SKIP() << "../shared/scenes not present";
+  const Scene scene = loadScene(test::sharedScene(GetParam().path));
+  const size_t n = GetParam().raysPerKind;
+  RayCasting rc(scene);
+  Camera camera = scene.hasCamera ? scene.camera : Camera{};
+  if (!scene.hasCamera) {
+    Vec3f lo, hi;
+    scene.bounds(lo, hi);
+    camera = frameBounds(lo, hi);
+  }
+  const int side = int(std::sqrt(double(n)));
+  const RayQueue primary = rc.work.primary(camera, side, side, 7);
+  rc.expectMatchesReference(rc.download(primary), "coherent (camera)");
+  const cl::Buffer hits = rc.work.closestHits(primary);
+  rc.expectMatchesReference(rc.download(rc.work.bounce(primary, hits, 11)), "from surfaces (bounce)");
+  if (!scene.lights.empty())
+    rc.expectMatchesReference(rc.download(rc.work.shadow(primary, hits, 13)), "from surfaces (shadow)");
+  for (const auto& [kind, rays] : hostRays(scene, n, 17)) rc.expectMatchesReference(rays, kind);
+}
+
+std::string scenePathName(const ::testing::TestParamInfo<ScenePath>& info) {
+  std::string name = info.param.path;
+  name = name.substr(name.rfind('/') + 1);
+  name = name.substr(0, name.find('.'));
+  if (std::string(info.param.path).find("legacy") != std::string::npos) name = "Legacy" + name;
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  return name;
+}
+
+// Fewer rays on the big scenes: the reference tests every triangle for every ray.
+INSTANTIATE_TEST_SUITE_P(
+    SharedScenes, AgainstBruteForce,
+    ::testing::Values(ScenePath{"cornell-box/CornellBox-Original.obj", 4096},
+                      ScenePath{"cornell-box/CornellBox-Mirror.obj", 1024},
+                      ScenePath{"cornell-box/CornellBox-Empty-RG.obj", 1024},
+                      ScenePath{"cornell-box/CornellBox-Empty-CO.obj", 1024},
+                      ScenePath{"cornell-box/CornellBox-Empty-White.obj", 1024},
+                      ScenePath{"cornell-box/CornellBox-Empty-Squashed.obj", 1024},
+                      ScenePath{"cornell-box/CornellBox-Sphere.obj", 1024},
+                      ScenePath{"cornell-box/CornellBox-Water.obj", 400},
+                      ScenePath{"cornell-box/CornellBox-Glossy.obj", 1024},
+                      ScenePath{"cornell-box/CornellBox-Glossy-Floor.obj", 256},
+                      ScenePath{"cornell-box/water.obj", 400},
+                      ScenePath{"cornell-box/legacy-glossy-2011/CornellBox-Glossy.obj", 400},
+                      ScenePath{"bunny/bunny.obj", 100},
+                      ScenePath{"bunny/CornellBox-Bunny.obj", 100},
+                      ScenePath{"mori-knob/testObj.obj", 256},
+                      ScenePath{"sponza/sponza.obj", 100},
+                      ScenePath{"veach-mis/veach_mis.obj", 256}),
+    scenePathName);
+
+// ---- Closed meshes and scene scales ----
+
+// An icosphere (subdivided icosahedron): closed, every edge shared by two triangles.
+Scene icosphere(int subdivisions, float scale, const float3& offset) {
+  const float g = (1.f + std::sqrt(5.f)) / 2.f;
+  std::vector<float3> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
+                           {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+  std::vector<std::array<unsigned, 3>> f = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11},
+                                            {1, 5, 9}, {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                            {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8}, {3, 8, 9},
+                                            {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  for (auto& p : v) p = normalize(p);
+  for (int s = 0; s < subdivisions; ++s) {
+    std::map<std::pair<unsigned, unsigned>, unsigned> mid;
+    auto midpoint = [&](unsigned a, unsigned b) {
+      const auto key = std::minmax(a, b);
+      auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      v.push_back(normalize((v[a] + v[b]) * 0.5f));
+      return mid[key] = unsigned(v.size() - 1);
+    };
+    std::vector<std::array<unsigned, 3>> next;
+    for (const auto& t : f) {
+      const unsigned a = midpoint(t[0], t[1]), b = midpoint(t[1], t[2]), c = midpoint(t[2], t[0]);
+      next.insert(next.end(), {{t[0], a, c}, {t[1], b, a}, {t[2], c, b}, {a, b, c}});
+    }
+    f = next;
+  }
+  Scene scene;
+  for (const auto& p : v) {
+    const float3 q = p * scale + offset;
+    scene.positions.insert(scene.positions.end(), q.begin(), q.end());
+  }
+  for (const auto& t : f) {
+    scene.indices.insert(scene.indices.end(), t.begin(), t.end());
+    scene.triangleMaterial.push_back(0);
+  }
+  scene.materials.push_back(Material{});
+  return scene;
+}
+
+// The same scene scaled about the origin, then translated.
+Scene transformed(Scene s, float scale, const float3& offset) {
+  for (size_t i = 0; i < s.positions.size(); ++i) s.positions[i] = s.positions[i] * scale + offset[i % 3];
+  s.camera.eye = s.camera.eye * scale + offset;
+  s.camera.target = s.camera.target * scale + offset;
+  return s;
+}
+
+struct Placement {
+  float scale;
+  float3 offset;
+};
+
+const Placement kPlacements[] = {
+    {1.f, {0, 0, 0}},      {1e-3f, {0, 0, 0}},           {1e4f, {0, 0, 0}},
+    {1.f, {1e4f, -2e4f, 3e4f}}, {1e-3f, {10.f, 20.f, -30.f}}, {1e4f, {1e8f, 0.f, -1e8f}},
+};
+
+std::string placementName(const Placement& p) {
+  std::ostringstream s;
+  s << "scale " << p.scale << " offset (" << p.offset[0] << "," << p.offset[1] << "," << p.offset[2] << ")";
+  return s.str();
+}
+
+TEST(Watertight, RaysAtSharedEdgesAndVerticesNeverMiss) {
+  for (const Placement& p : kPlacements) {
+    const float3 center = p.offset;
+    const Scene sphere = icosphere(3, p.scale, center);
+    RayCasting rc(sphere);
+    Rays inside, outside;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    for (size_t t = 0; t < sphere.triangleCount(); ++t) {
+      for (int k = 0; k < 3; ++k) {
+        const float3 a = sphere.corner(t, k), b = sphere.corner(t, (k + 1) % 3);
+        const float3 mid = (a + b) * 0.5f, vertex = a;
+        // From inside (the centre and a random inner point) every direction must hit.
+        inside.add(center, normalize(vertex - center));
+        inside.add(center, normalize(mid - center));
+        const float3 inner = center + randomDirection(rng) * (0.5f * p.scale * u(rng));
+        inside.add(inner, normalize(mid - inner));
+        // From outside, at a point that sees the edge's front.
+        const float3 from = center + normalize(mid - center) * (3.f * p.scale) + randomDirection(rng) * (0.5f * p.scale);
+        outside.add(from, normalize(mid - from));
+        outside.add(from, normalize(vertex - from));
+      }
+    }
+    const std::string name = placementName(p);
+    rc.expectMatchesReference(inside, "inside, " + name);
+    EXPECT_EQ(rc.lastHitFraction, 1.0) << "rays from inside a closed mesh escaped: " << name;
+    rc.expectMatchesReference(outside, "outside, " + name);
+    EXPECT_EQ(rc.lastHitFraction, 1.0) << "rays at front-facing edges and vertices missed: " << name;
+  }
+}
+
+// Bounce and shadow rays spawned from hits never hit the triangle they leave, and
+// shadow rays never hit the light triangle they aim at.
+TEST(SelfIntersection, SpawnedRaysNeverReHitTheirTriangleAtAnyScale) {
+  const Scene base = loadDefaultScene();
+  for (const Placement& p : kPlacements) {
+    const Scene scene = transformed(base, p.scale, p.offset);
+    RayCasting rc(scene);
+    const RayQueue primary = rc.work.primary(scene.camera, 96, 96, 3);
+    const cl::Buffer primaryHits = rc.work.closestHits(primary);
+    const std::vector<float> firstHits = rc.work.readFloat4(primaryHits, primary.count);
+    for (int kind = 0; kind < 2; ++kind) {
+      const RayQueue spawned =
+          kind == 0 ? rc.work.bounce(primary, primaryHits, 21) : rc.work.shadow(primary, primaryHits, 23);
+      ASSERT_GT(spawned.count, primary.count / 2) << placementName(p);
+      const std::vector<float> hits = rc.work.readFloat4(rc.work.closestHits(spawned), spawned.count);
+      const std::vector<unsigned> source = rc.work.readUints(spawned.source, spawned.count);
+      size_t selfHits = 0, escaped = 0;
+      for (size_t i = 0; i < spawned.count; ++i) {
+        int from, to;
+        std::memcpy(&from, &firstHits[4 * source[i] + 3], 4);
+        std::memcpy(&to, &hits[4 * i + 3], 4);
+        selfHits += to == from;
+        escaped += kind == 0 && to < 0;
+      }
+      EXPECT_EQ(selfHits, 0u) << (kind == 0 ? "bounce" : "shadow") << " rays, " << placementName(p);
+      // The box is open only at the front: most bounces stay inside.
+      if (kind == 0) {
+        EXPECT_LT(escaped, spawned.count / 2) << placementName(p);
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace fh
