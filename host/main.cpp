@@ -5,12 +5,16 @@
 #include <iostream>
 #include <sstream>
 
+#include "bench.h"
 #include "bvh.h"
 #include "devices.h"
 #include "error.h"
 #include "image_io.h"
 #include "render_aov.h"
 #include "scene_loader.h"
+#ifdef FREDHOLM_HAVE_EMBREE
+#include "embree_tracer.h"
+#endif
 
 namespace {
 
@@ -131,6 +135,22 @@ int main(int argc, char** argv) {
   rendering->add_option("--aov", render.aov, "Debug output: albedo, normal or depth")->capture_default_str();
   rendering->add_option("--device", render.device, "Device: index, list (0,1), type (cpu, gpu, all) or name");
 
+  BenchOptions bench;
+  auto* benching = app.add_subcommand("bench", "Measure ray-casting throughput (Mrays/s) per scene and ray kind");
+  benching->add_option("scenes", bench.scenes,
+                       "Scenes: cornell, bunny-box, sponza, bunnies-1m, or OBJ files (default: all four)");
+  benching->add_option("--device", bench.device, "Device: index, type or name (the first match is used)");
+  benching->add_option("--json", bench.jsonPath, "Write the results as JSON");
+  benching->add_flag("--force", bench.force, "Overwrite an existing --json file");
+  benching->add_option("--width", bench.width, "Primary rays per batch: width x height")->capture_default_str();
+  benching->add_option("--height", bench.height, "Primary rays per batch: width x height")->capture_default_str();
+  benching->add_option("--repeats", bench.repeats, "Timed runs after a warm-up (median reported)")
+      ->capture_default_str();
+  benching->add_option("--threads", bench.threads, "Threads for the external tracer")->capture_default_str();
+#ifdef FREDHOLM_HAVE_EMBREE
+  bench.external = makeEmbreeTracer;
+#endif
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -139,6 +159,7 @@ int main(int argc, char** argv) {
   try {
     if (*devices) return runDevices(devicesSpec);
     if (*rendering) return runRender(render);
+    if (*benching) return runBench(bench);
   } catch (const BuildError& e) {
     std::cerr << "fredholm: error: " << e.what() << "\n";
     return 1;

@@ -1,0 +1,7 @@
+// Embree 3 as the reference CPU tracer for `fredholm bench`.
+#pragma once
+#include "external_tracer.h"
+
+namespace fh {
+std::unique_ptr<ExternalTracer> makeEmbreeTracer();
+}
