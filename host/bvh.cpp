@@ -12,8 +12,11 @@ namespace fh {
 namespace {
 
 constexpr int kBins = 32;
-constexpr unsigned kMaxLeaf = 8;       // within FH_MAX_LEAF_TRIANGLES
-constexpr float kTraversalCost = 1.0f;  // relative to one triangle test
+constexpr unsigned kMaxLeaf = FH_MAX_LEAF_TRIANGLES;
+// SAH costs relative to one box test. A leaf's triangles are tested eight at a time
+// (TriangleBlock8), so a triangle costs a fraction of a box test and leaves fill up.
+constexpr float kTraversalCost = 1.0f;
+constexpr float kTriangleCost = 0.25f;
 
 struct Box {
   float3 lo{INFINITY, INFINITY, INFINITY};
@@ -97,7 +100,8 @@ class BinaryBuilder {
         acc.grow(bins[b]);
         n += counts[b];
         if (n == 0 || rightCount[b + 1] == 0) continue;
-        const float cost = kTraversalCost + (acc.area() * n + rightArea[b + 1] * rightCount[b + 1]) / parentArea;
+        const float cost =
+            kTraversalCost + kTriangleCost * (acc.area() * n + rightArea[b + 1] * rightCount[b + 1]) / parentArea;
         if (cost < best.cost) best = {axis, lo + (b + 1) / scale, cost};
       }
     }
@@ -122,7 +126,7 @@ class BinaryBuilder {
     const Split s = findSplit(first, count, centroidBox, area);
     unsigned mid = first;
     if (s.axis >= 0) {
-      if (count <= kMaxLeaf && float(count) <= s.cost) return makeLeaf(node, first, count);
+      if (count <= kMaxLeaf && kTriangleCost * float(count) <= s.cost) return makeLeaf(node, first, count);
       auto* begin = index_.data() + first;
       mid = unsigned(std::partition(begin, begin + count,
                                     [&](unsigned t) { return centroids_[t][size_t(s.axis)] < s.position; }) -
@@ -150,7 +154,9 @@ class BinaryBuilder {
 
 class WideCollapser {
  public:
-  WideCollapser(const std::vector<BinaryNode>& binary, Bvh& out) : binary_(binary), out_(out) {}
+  WideCollapser(const std::vector<BinaryNode>& binary, const Scene& scene, const std::vector<unsigned>& order,
+                Bvh& out)
+      : binary_(binary), scene_(scene), order_(order), out_(out) {}
 
   void collapseRoot() {
     if (binary_[0].count > 0) {
@@ -168,12 +174,28 @@ class WideCollapser {
  private:
   static void clearNode(gpu::Bvh8Node& n) { std::memset(&n, 0, sizeof n); }
 
+  // The leaf's triangles [first, first + count) in BVH order, as one SoA block.
+  int addBlock(unsigned first, unsigned count) {
+    gpu::TriangleBlock8 block;
+    std::memset(&block, 0, sizeof block);
+    for (unsigned lane = 0; lane < 8; ++lane) {
+      block.id[lane] = lane < count ? int(first + lane) : -1;
+      if (lane >= count) continue;
+      for (int k = 0; k < 3; ++k) {
+        const float3 p = scene_.corner(order_[first + lane], k);
+        for (int axis = 0; axis < 3; ++axis) block.v[k][axis][lane] = p[size_t(axis)];
+      }
+    }
+    out_.blocks.push_back(block);
+    return int(out_.blocks.size() - 1);
+  }
+
   // Slot `slot` of wide node `wide` gets binary node `b`, whose subtree is at `depth`.
   void setChild(int wide, int slot, int b, int depth) {
     const BinaryNode& child = binary_[size_t(b)];
     int ref;
     if (child.count > 0) {
-      ref = ~int(child.first << FH_LEAF_BITS | child.count);
+      ref = ~addBlock(child.first, child.count);
       ++out_.stats.leaves;
       out_.stats.depth = std::max(out_.stats.depth, depth);
     } else {
@@ -215,6 +237,8 @@ class WideCollapser {
   }
 
   const std::vector<BinaryNode>& binary_;
+  const Scene& scene_;
+  const std::vector<unsigned>& order_;
   Bvh& out_;
 };
 
@@ -228,7 +252,7 @@ Bvh buildBvh(const Scene& scene) {
   bvh.order = builder.order();
   bvh.stats.binaryNodes = binary.size();
 
-  WideCollapser(binary, bvh).collapseRoot();
+  WideCollapser(binary, scene, bvh.order, bvh).collapseRoot();
   bvh.stats.wideNodes = bvh.nodes.size();
 
   bvh.triangles.resize(12 * bvh.order.size());

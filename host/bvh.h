@@ -10,6 +10,7 @@
 namespace fh {
 
 static_assert(sizeof(gpu::Bvh8Node) == 224, "Bvh8Node layout must match the device");
+static_assert(sizeof(gpu::TriangleBlock8) == 320, "TriangleBlock8 layout must match the device");
 static_assert(sizeof(gpu::CameraParams) == 80, "CameraParams layout must match the device");
 
 struct BvhStats {
@@ -22,13 +23,15 @@ struct BvhStats {
 
 struct Bvh {
   std::vector<gpu::Bvh8Node> nodes;
-  std::vector<float> triangles;  // 12 floats per triangle: v0.xyz id, v1.xyz 0, v2.xyz 0 (BVH order)
+  std::vector<gpu::TriangleBlock8> blocks;  // one per leaf, for the intersect kernels
+  std::vector<float> triangles;  // 12 floats per triangle in BVH order: v0.xyz id, v1.xyz 0, v2.xyz 0
   std::vector<unsigned> order;   // order[k]: the file-order id of the k-th triangle in BVH order
   BvhStats stats;
 
-  size_t bytes() const { return nodes.size() * sizeof(gpu::Bvh8Node) + triangles.size() * sizeof(float); }
-  // Entries the traversal stack needs: each wide level pops one node and pushes up to 8.
-  int traversalStack() const { return 7 * stats.depth + 2; }
+  // Device memory of the structure the intersect kernels read (nodes and leaf blocks).
+  size_t bytes() const { return nodes.size() * sizeof(gpu::Bvh8Node) + blocks.size() * sizeof(gpu::TriangleBlock8); }
+  // Entries the traversal stack needs: each wide level defers up to 7 children.
+  int traversalStack() const { return 7 * stats.depth + 1; }
 };
 
 Bvh buildBvh(const Scene& scene);

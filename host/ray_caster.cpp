@@ -22,8 +22,10 @@ RayCaster::RayCaster(DeviceContext& dc, const Bvh& bvh) : dc_(dc) {
   options_ = "-DFH_TRAVERSAL_STACK=" + std::to_string(bvh.traversalStack());
   nodes_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, bvh.nodes.size() * sizeof(gpu::Bvh8Node),
                           "BVH nodes", bvh.nodes.data());
+  blocks_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY,
+                           bvh.blocks.size() * sizeof(gpu::TriangleBlock8), "BVH leaf triangles", bvh.blocks.data());
   triangles_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, bvh.triangles.size() * sizeof(float),
-                              "BVH triangles", bvh.triangles.data());
+                              "triangles", bvh.triangles.data());
   const cl::Program program = buildProgram(dc.context, dc.info.device, {"intersect.cl"}, options_, &buildInfo_);
   closest_ = createKernel(program, "intersect_closest");
   any_ = createKernel(program, "intersect_any");
@@ -32,7 +34,7 @@ RayCaster::RayCaster(DeviceContext& dc, const Bvh& bvh) : dc_(dc) {
 void RayCaster::intersectClosest(const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& hits,
                                  unsigned count, cl::Event* event) {
   FH_CL(closest_.setArg(0, nodes_));
-  FH_CL(closest_.setArg(1, triangles_));
+  FH_CL(closest_.setArg(1, blocks_));
   FH_CL(closest_.setArg(2, org));
   FH_CL(closest_.setArg(3, dir));
   FH_CL(closest_.setArg(4, hits));
@@ -43,7 +45,7 @@ void RayCaster::intersectClosest(const cl::Buffer& org, const cl::Buffer& dir, c
 void RayCaster::intersectAny(const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& occluded,
                              unsigned count, cl::Event* event) {
   FH_CL(any_.setArg(0, nodes_));
-  FH_CL(any_.setArg(1, triangles_));
+  FH_CL(any_.setArg(1, blocks_));
   FH_CL(any_.setArg(2, org));
   FH_CL(any_.setArg(3, dir));
   FH_CL(any_.setArg(4, occluded));

@@ -38,6 +38,7 @@ class RayCaster {
                     cl::Event* event = nullptr);
 
   const cl::Buffer& nodes() const { return nodes_; }
+  // Triangles in BVH order (three float4 each), for turning hits into surface points.
   const cl::Buffer& triangles() const { return triangles_; }
   // Build options every program that traverses this BVH must use.
   const std::string& traversalOptions() const { return options_; }
@@ -46,7 +47,7 @@ class RayCaster {
  private:
   DeviceContext& dc_;
   std::string options_;
-  cl::Buffer nodes_, triangles_;
+  cl::Buffer nodes_, blocks_, triangles_;
   ProgramBuildInfo buildInfo_;
   cl::Kernel closest_, any_;
 };

@@ -17,12 +17,13 @@
 #endif
 
 // Per-ray constants of the watertight test: the axis the ray is most aligned with
-// (kz) and the shear that maps the ray onto +z.
+// (kz), the shear that maps the ray onto +z, and the origin in that axis order.
 typedef struct {
   float3 org;
   float3 inv_dir;
   int kx, ky, kz;
   float sx, sy, sz;
+  float ox, oy, oz;  // origin components along kx, ky, kz
 } RayPrecomp;
 
 inline float component(float3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
@@ -44,6 +45,9 @@ inline RayPrecomp precompute_ray(float3 org, float3 dir) {
   r.sx = component(dir, r.kx) / dz;
   r.sy = component(dir, r.ky) / dz;
   r.sz = 1.0f / dz;
+  r.ox = component(org, r.kx);
+  r.oy = component(org, r.ky);
+  r.oz = component(org, r.kz);
   // Zero direction components would give 0 * inf = NaN in the slab test; a tiny value
   // keeps the reciprocal finite-signed and the test conservative.
   const float tiny = 1e-30f;
@@ -54,32 +58,47 @@ inline RayPrecomp precompute_ray(float3 org, float3 dir) {
   return r;
 }
 
-// Watertight test. On a hit closer than *t_max (and at least t_min), updates *t_max and
-// the barycentrics (b1, b2) of v1 and v2, and returns true.
-inline bool intersect_triangle(const RayPrecomp* r, float3 v0, float3 v1, float3 v2, float t_min, float* t_max,
-                               float* b1, float* b2) {
-  const float3 a = v0 - r->org, b = v1 - r->org, c = v2 - r->org;
-  const float az = component(a, r->kz), bz = component(b, r->kz), cz = component(c, r->kz);
-  const float ax = component(a, r->kx) - r->sx * az, ay = component(a, r->ky) - r->sy * az;
-  const float bx = component(b, r->kx) - r->sx * bz, by = component(b, r->ky) - r->sy * bz;
-  const float cx = component(c, r->kx) - r->sx * cz, cy = component(c, r->ky) - r->sy * cz;
-  const float u = cx * by - cy * bx;
-  const float v = ax * cy - ay * cx;
-  const float w = bx * ay - by * ax;
-  if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
-  const float det = u + v + w;
-  if (det == 0.0f) return false;
-  const float t_scaled = u * r->sz * az + v * r->sz * bz + w * r->sz * cz;
+// The watertight test on the eight triangles of a leaf at once. Returns the lane of the
+// closest hit in [t_min, *t_max) (updating *t_max and the barycentrics b1, b2 of v1 and
+// v2), or -1.
+inline int intersect_block(const RayPrecomp* r, __global const TriangleBlock8* block, float t_min, float* t_max,
+                           float* b1, float* b2) {
+  __global const float* v0 = block->v[0][0];
+  __global const float* v1 = block->v[1][0];
+  __global const float* v2 = block->v[2][0];
+  const int kx = 8 * r->kx, ky = 8 * r->ky, kz = 8 * r->kz;
+  const float8 az = vload8(0, v0 + kz) - r->oz, bz = vload8(0, v1 + kz) - r->oz, cz = vload8(0, v2 + kz) - r->oz;
+  const float8 ax = (vload8(0, v0 + kx) - r->ox) - r->sx * az, ay = (vload8(0, v0 + ky) - r->oy) - r->sy * az;
+  const float8 bx = (vload8(0, v1 + kx) - r->ox) - r->sx * bz, by = (vload8(0, v1 + ky) - r->oy) - r->sy * bz;
+  const float8 cx = (vload8(0, v2 + kx) - r->ox) - r->sx * cz, cy = (vload8(0, v2 + ky) - r->oy) - r->sy * cz;
+  const float8 u = cx * by - cy * bx;
+  const float8 v = ax * cy - ay * cx;
+  const float8 w = bx * ay - by * ax;
+  const float8 zero = (float8)(0.0f);
+  const int8 outside = ((u < zero) | (v < zero) | (w < zero)) & ((u > zero) | (v > zero) | (w > zero));
+  const float8 det = u + v + w;
+  const float8 t_scaled = u * r->sz * az + v * r->sz * bz + w * r->sz * cz;
   // Compare t against the interval without dividing: flip by det's sign.
-  const float sign = det < 0.0f ? -1.0f : 1.0f;
-  const float abs_det = fabs(det);
-  const float ts = t_scaled * sign;
-  if (ts < t_min * abs_det || ts >= *t_max * abs_det) return false;
-  const float inv_det = 1.0f / det;
-  *t_max = t_scaled * inv_det;
-  *b1 = v * inv_det;
-  *b2 = w * inv_det;
-  return true;
+  const float8 abs_det = fabs(det);
+  const float8 ts = select(t_scaled, -t_scaled, det < zero);
+  const int8 valid = ~outside & (det != zero) & (ts >= t_min * abs_det) & (ts < *t_max * abs_det);
+  if (!any(valid)) return -1;
+  const float8 t = select((float8)(INFINITY), t_scaled / det, valid);
+  float lanes[8];
+  vstore8(t, 0, lanes);
+  int best = -1;
+  for (int i = 0; i < 8; ++i)
+    if (lanes[i] < *t_max) {
+      *t_max = lanes[i];
+      best = i;
+    }
+  float vs[8], ws[8], ds[8];
+  vstore8(v, 0, vs);
+  vstore8(w, 0, ws);
+  vstore8(det, 0, ds);
+  *b1 = vs[best] / ds[best];
+  *b2 = ws[best] / ds[best];
+  return best;
 }
 
 // 1 + 2 gamma(3): widens the far slab distance so rounding never culls a box that the
@@ -103,12 +122,14 @@ inline float8 intersect_children(const RayPrecomp* r, __global const Bvh8Node* n
 
 typedef struct {
   float t, b1, b2;
-  int triangle;  // index into the ordered triangle array, -1 for a miss
+  int triangle;  // index in BVH order, -1 for a miss
 } TraceHit;
 
-// Pushes the children the ray hits, farthest first, so the nearest is popped next.
-inline void push_hit_children(float8 t_near, __global const Bvh8Node* node, int* stack_node, float* stack_t,
-                              int* sp) {
+// Visits the children the ray hits nearest first: returns the nearest (0 if none) and
+// pushes the others, farthest first, with their distances. Any-hit queries skip the
+// sort: any occluder ends them, near or far.
+inline int order_children(float8 t_near, __global const Bvh8Node* node, int* stack_node, float* stack_t, int* sp,
+                          bool sorted) {
   float t[8];
   vstore8(t_near, 0, t);
   int order[8];
@@ -117,22 +138,24 @@ inline void push_hit_children(float8 t_near, __global const Bvh8Node* node, int*
     if (t[i] == INFINITY) continue;
     // Insertion sort by decreasing distance.
     int j = n++;
-    while (j > 0 && t[order[j - 1]] < t[i]) {
+    while (sorted && j > 0 && t[order[j - 1]] < t[i]) {
       order[j] = order[j - 1];
       --j;
     }
     order[j] = i;
   }
-  for (int k = 0; k < n && *sp < FH_TRAVERSAL_STACK; ++k) {
+  if (n == 0) return 0;
+  for (int k = 0; k < n - 1; ++k) {
     stack_node[*sp] = node->child[order[k]];
     stack_t[*sp] = t[order[k]];
     ++*sp;
   }
+  return node->child[order[n - 1]];
 }
 
 // Closest hit (any_hit == false) or the first hit found (any_hit == true) in [t_min, t_max).
-inline TraceHit trace_ray(__global const Bvh8Node* nodes, __global const float4* triangles, float3 org, float3 dir,
-                          float t_min, float t_max, bool any_hit) {
+inline TraceHit trace_ray(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, float3 org,
+                          float3 dir, float t_min, float t_max, bool any_hit) {
   const RayPrecomp r = precompute_ray(org, dir);
   TraceHit hit;
   hit.t = t_max;
@@ -141,28 +164,31 @@ inline TraceHit trace_ray(__global const Bvh8Node* nodes, __global const float4*
   int stack_node[FH_TRAVERSAL_STACK];
   float stack_t[FH_TRAVERSAL_STACK];
   int sp = 0;
-  stack_node[sp] = 0;
-  stack_t[sp++] = 0.0f;
-  while (sp > 0) {
-    --sp;
-    const int ref = stack_node[sp];
-    if (stack_t[sp] > hit.t) continue;  // a closer hit was found since this was pushed
+  int ref = 0;  // the root
+  for (;;) {
     if (ref >= 0) {
       __global const Bvh8Node* node = nodes + ref;
-      push_hit_children(intersect_children(&r, node, hit.t), node, stack_node, stack_t, &sp);
-      continue;
-    }
-    const uint packed = (uint)(~ref);
-    const uint first = packed >> FH_LEAF_BITS, count = packed & ((1u << FH_LEAF_BITS) - 1u);
-    for (uint i = first; i < first + count; ++i) {
-      const float4 v0 = triangles[3 * i], v1 = triangles[3 * i + 1], v2 = triangles[3 * i + 2];
-      if (intersect_triangle(&r, v0.xyz, v1.xyz, v2.xyz, t_min, &hit.t, &hit.b1, &hit.b2)) {
-        hit.triangle = (int)i;
+      ref = order_children(intersect_children(&r, node, hit.t), node, stack_node, stack_t, &sp, !any_hit);
+      if (ref != 0) continue;
+    } else {
+      __global const TriangleBlock8* block = blocks + ~ref;
+      const int lane = intersect_block(&r, block, t_min, &hit.t, &hit.b1, &hit.b2);
+      if (lane >= 0) {
+        hit.triangle = block->id[lane];
         if (any_hit) return hit;
       }
     }
+    // Pop the nearest pending child that may still hold a closer hit.
+    ref = 0;
+    while (sp > 0) {
+      --sp;
+      if (stack_t[sp] <= hit.t) {
+        ref = stack_node[sp];
+        break;
+      }
+    }
+    if (ref == 0) return hit;
   }
-  return hit;
 }
 
 #endif

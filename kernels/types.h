@@ -11,19 +11,26 @@ typedef std::uint32_t uint;
 #endif
 
 #define FH_BVH_WIDTH 8
-#define FH_LEAF_BITS 4                       // triangles per leaf stored in the low bits
-#define FH_MAX_LEAF_TRIANGLES 15
+#define FH_MAX_LEAF_TRIANGLES 8  // a leaf is one TriangleBlock8
 
 // An 8-wide BVH node: child boxes stored as structure of arrays so one work-item tests
 // all eight with float8 operations. child[i] > 0: inner node index; child[i] < 0: leaf,
-// with ~child[i] = first_triangle << FH_LEAF_BITS | count; child[i] == 0: empty slot
-// (the root, index 0, is never a child).
+// the TriangleBlock8 with index ~child[i]; child[i] == 0: empty slot (the root, index 0,
+// is never a child).
 typedef struct {
   float lo_x[8], hi_x[8];
   float lo_y[8], hi_y[8];
   float lo_z[8], hi_z[8];
   int child[8];
 } Bvh8Node;
+
+// A leaf's triangles (up to eight) as structure of arrays, so one work-item tests them
+// all with float8 operations: v[vertex][axis][lane]. id[lane] is the triangle's index in
+// BVH order (-1 for an unused lane, whose vertices are all zero).
+typedef struct {
+  float v[3][3][8];
+  int id[8];
+} TriangleBlock8;
 
 // Camera for the generate kernel; see host/camera.h for the conventions.
 typedef struct {
