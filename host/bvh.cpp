@@ -16,7 +16,7 @@ constexpr unsigned kMaxLeaf = FH_MAX_LEAF_TRIANGLES;
 // SAH costs relative to one box test. A leaf's triangles are tested eight at a time
 // (TriangleBlock8), so a triangle costs a fraction of a box test and leaves fill up.
 constexpr float kTraversalCost = 1.0f;
-constexpr float kTriangleCost = 0.25f;
+constexpr float kTriangleCost = 0.15f;
 
 struct Box {
   float3 lo{INFINITY, INFINITY, INFINITY};

@@ -11,6 +11,10 @@
 // the other, opening cracks along shared edges.
 #pragma OPENCL FP_CONTRACT OFF
 
+// The traversal's helpers must be inlined into the kernel: called out of line they pass
+// the ray and the stack through memory (PoCL's LLVM declines to inline them by itself).
+#define FH_INLINE inline __attribute__((always_inline))
+
 // The host passes the stack depth its BVH needs (7 per wide level + 1) as a build option.
 #ifndef FH_TRAVERSAL_STACK
 #define FH_TRAVERSAL_STACK 64
@@ -26,9 +30,9 @@ typedef struct {
   float ox, oy, oz;  // origin components along kx, ky, kz
 } RayPrecomp;
 
-inline float component(float3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
+FH_INLINE float component(float3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
 
-inline RayPrecomp precompute_ray(float3 org, float3 dir) {
+FH_INLINE RayPrecomp precompute_ray(float3 org, float3 dir) {
   RayPrecomp r;
   r.org = org;
   const float3 a = fabs(dir);
@@ -61,7 +65,7 @@ inline RayPrecomp precompute_ray(float3 org, float3 dir) {
 // The watertight test on the eight triangles of a leaf at once. Returns the lane of the
 // closest hit in [t_min, *t_max) (updating *t_max and the barycentrics b1, b2 of v1 and
 // v2), or -1.
-inline int intersect_block(const RayPrecomp* r, __global const TriangleBlock8* block, float t_min, float* t_max,
+FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8* block, float t_min, float* t_max,
                            float* b1, float* b2) {
   __global const float* v0 = block->v[0][0];
   __global const float* v1 = block->v[1][0];
@@ -106,7 +110,7 @@ inline int intersect_block(const RayPrecomp* r, __global const TriangleBlock8* b
 #define FH_SLAB_WIDEN 1.0000003576f
 
 // Near distances of the eight children; lanes the ray misses get +INFINITY.
-inline float8 intersect_children(const RayPrecomp* r, __global const Bvh8Node* node, float t_max) {
+FH_INLINE float8 intersect_children(const RayPrecomp* r, __global const Bvh8Node* node, float t_max) {
   const float8 ox = (float8)(r->org.x), oy = (float8)(r->org.y), oz = (float8)(r->org.z);
   const float8 ix = (float8)(r->inv_dir.x), iy = (float8)(r->inv_dir.y), iz = (float8)(r->inv_dir.z);
   const float8 tx0 = (vload8(0, node->lo_x) - ox) * ix, tx1 = (vload8(0, node->hi_x) - ox) * ix;
@@ -128,7 +132,7 @@ typedef struct {
 // Visits the children the ray hits nearest first: returns the nearest (0 if none) and
 // pushes the others, farthest first, with their distances. Any-hit queries skip the
 // sort: any occluder ends them, near or far.
-inline int order_children(float8 t_near, __global const Bvh8Node* node, int* stack_node, float* stack_t, int* sp,
+FH_INLINE int order_children(float8 t_near, __global const Bvh8Node* node, int* stack_node, float* stack_t, int* sp,
                           bool sorted) {
   float t[8];
   vstore8(t_near, 0, t);
@@ -154,7 +158,7 @@ inline int order_children(float8 t_near, __global const Bvh8Node* node, int* sta
 }
 
 // Closest hit (any_hit == false) or the first hit found (any_hit == true) in [t_min, t_max).
-inline TraceHit trace_ray(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, float3 org,
+FH_INLINE TraceHit trace_ray(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, float3 org,
                           float3 dir, float t_min, float t_max, bool any_hit) {
   const RayPrecomp r = precompute_ray(org, dir);
   TraceHit hit;

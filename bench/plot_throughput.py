@@ -1,0 +1,51 @@
+#!/usr/bin/env python3
+"""Chart of ray-casting throughput against scene size from `fredholm bench --json`.
+
+usage: bench/plot_throughput.py bench.json [out.png]
+
+One line per ray kind for fredholm (solid) and, when the JSON has them, Embree's best API
+(dashed). Needs Debian's python3-matplotlib.
+"""
+import json
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def main():
+    if len(sys.argv) < 2:
+        sys.exit(__doc__)
+    with open(sys.argv[1]) as f:
+        doc = json.load(f)
+    out = sys.argv[2] if len(sys.argv) > 2 else sys.argv[1].rsplit(".", 1)[0] + ".png"
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    colors = {"primary": "tab:blue", "bounce": "tab:red", "shadow": "tab:green"}
+    for kind, color in colors.items():
+        rows = sorted((r for r in doc["records"] if r["ray_kind"] == kind), key=lambda r: r["triangles"])
+        if not rows:
+            continue
+        tris = [r["triangles"] for r in rows]
+        ax.plot(tris, [r["mrays_per_s"] for r in rows], "o-", color=color, label=f"fredholm {kind}")
+        if all("embree_mrays_per_s" in r for r in rows):
+            ax.plot(tris, [r["embree_mrays_per_s"] for r in rows], "s--", color=color, alpha=0.6,
+                    label=f"Embree best API {kind}")
+        for r in rows:
+            ax.annotate(r["scene"], (r["triangles"], r["mrays_per_s"]), fontsize=7, alpha=0.6,
+                        textcoords="offset points", xytext=(3, 3))
+    ax.set_xscale("log")
+    ax.set_xlabel("triangles")
+    ax.set_ylabel("Mrays/s")
+    ax.set_title(f"Ray casting throughput on {doc['device']}\n"
+                 f"({doc['primary_rays']} primary rays per batch, median of {doc['repeats']})", fontsize=9)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(out, dpi=120)
+    print(f"wrote {out}")
+
+
+if __name__ == "__main__":
+    main()
