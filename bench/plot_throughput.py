@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Chart of ray-casting throughput against scene size from `fredholm bench --json`.
 
 usage: bench/plot_throughput.py bench.json [out.png]
