@@ -2,6 +2,9 @@
 #include <CLI/CLI.hpp>
 
 #include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
 
@@ -10,6 +13,7 @@
 #include "devices.h"
 #include "error.h"
 #include "image_io.h"
+#include "path_tracer.h"
 #include "render_aov.h"
 #include "scene_loader.h"
 #ifdef FREDHOLM_HAVE_EMBREE
@@ -24,11 +28,15 @@ struct RenderOptions {
   std::string scene;
   std::string output;
   bool force = false;
-  int width = 512, height = 512, spp = 4;
+  int width = 512, height = 512, spp = 0;
+  double seconds = 0.0;
+  std::string method = "mis", filter = "box", env, statsFile;
+  int maxDepth = 64;
+  size_t wavefront = 0;
   unsigned seed = 1;
   std::string cameraFile, eye, target, up;
   float fov = 0.f;
-  std::string aov = "albedo";
+  std::string aov;
   std::string device;
 };
 
@@ -65,13 +73,33 @@ int runDevices(const std::string& spec) {
   return 0;
 }
 
+std::string formatSeconds(double s) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(2) << s;
+  return out.str();
+}
+
 int runRender(RenderOptions o) {
-  const Aov aov = parseAov(o.aov);
+  // Every flag is checked before any work starts.
+  const bool debugView = !o.aov.empty();
+  const Aov aov = debugView ? parseAov(o.aov) : Aov::Albedo;
+  RenderSettings settings;
+  settings.method = parseMethod(o.method);
+  settings.filter = parseFilter(o.filter);
+  if (!o.env.empty()) settings.env = parseVec3Flag("--env", o.env);
   if (o.width <= 0 || o.height <= 0) throw Error("--width/--height must be positive");
-  if (o.spp <= 0) throw Error("--spp must be positive");
+  if (o.spp < 0) throw Error("--spp must be positive");
+  if (o.seconds < 0) throw Error("--time must be positive");
+  if (o.maxDepth < 1) throw Error("--max-depth must be at least 1");
+  if (o.wavefront != 0 && o.wavefront < kLocalSize) throw Error("--wavefront must be at least 64");
+  // With --time and no --spp, the time decides; otherwise 64 spp by default.
+  const int spp = o.spp > 0 ? o.spp : (o.seconds > 0 ? (1 << 20) : (debugView ? 4 : 64));
   // An explicit -o is never overwritten without --force; the default name steps aside.
   if (o.output.empty()) o.output = firstFreeName("fredholm.png");
   checkOutputPath(o.output, o.force);
+  if (!o.statsFile.empty()) checkOutputPath(o.statsFile + ".png", true, "--stats");  // the directory
+  if (!o.statsFile.empty() && std::filesystem::exists(o.statsFile) && !o.force)
+    throw Error("--stats '" + o.statsFile + "': file exists (pass --force to overwrite it)");
 
   const auto devices = selectDevices(listDevices(), o.device);
   if (devices.size() > 1)
@@ -84,23 +112,51 @@ int runRender(RenderOptions o) {
   const auto start = std::chrono::steady_clock::now();
   const Bvh bvh = buildBvh(scene);
   DeviceContext dc(devices[0]);
-  AovSettings settings;
-  settings.width = o.width;
-  settings.height = o.height;
-  settings.spp = o.spp;
-  settings.seed = o.seed;
-  settings.mode = aov;
-  const Image image = renderAov(dc, scene, bvh, camera, settings);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  std::ostringstream time;
-  time << seconds;
+  Image image;
+  std::string method;
+  uint64_t samples = 0;
+  if (debugView) {
+    AovSettings a;
+    a.width = o.width;
+    a.height = o.height;
+    a.spp = spp;
+    a.seed = o.seed;
+    a.mode = aov;
+    image = renderAov(dc, scene, bvh, camera, a);
+    method = "aov:" + o.aov;
+    samples = uint64_t(spp) * uint64_t(o.width) * uint64_t(o.height);
+  } else {
+    settings.width = o.width;
+    settings.height = o.height;
+    settings.spp = spp;
+    settings.seconds = o.seconds;
+    settings.maxDepth = o.maxDepth;
+    settings.seed = o.seed;
+    settings.wavefront = o.wavefront;
+    settings.progress = true;
+    PathTracer tracer(dc, scene, bvh, camera, settings);
+    const Film film = tracer.render();
+    image = film.image();
+    method = methodName(settings.method);
+    samples = tracer.stats().samples;
+    if (tracer.stats().nonfinite)
+      std::cerr << "fredholm: warning: " << tracer.stats().nonfinite << " samples were NaN or infinite and dropped\n";
+    if (!o.statsFile.empty()) {
+      std::ofstream out(o.statsFile);
+      out << statsJson(tracer.stats(), settings) << "\n";
+      if (!out) throw Error("--stats '" + o.statsFile + "': cannot write");
+    }
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double spp_done = double(samples) / (double(o.width) * o.height);
   writeImage(o.output, image,
-             {{"scene", scene.sourcePath}, {"spp", std::to_string(o.spp)}, {"method", "aov:" + o.aov},
-              {"device", devices[0].name}, {"seed", std::to_string(o.seed)}, {"seconds", time.str()}});
+             {{"scene", scene.sourcePath}, {"spp", formatSeconds(spp_done)}, {"method", method},
+              {"device", devices[0].name}, {"seed", std::to_string(o.seed)}, {"seconds", formatSeconds(seconds)},
+              {"filter", o.filter}, {"max_depth", std::to_string(o.maxDepth)}});
   std::cerr << "fredholm: rendered " << scene.sourcePath << " (" << scene.triangleCount() << " triangles, "
-            << scene.lights.size() << " emissive) as " << o.aov << ", " << o.width << "x" << o.height << ", "
-            << o.spp << " spp on " << devices[0].name << " in " << time.str() << " s\n";
+            << scene.lights.size() << " emissive) with " << method << ", " << o.width << "x" << o.height << ", "
+            << spp_done << " spp on " << devices[0].name << " in " << formatSeconds(seconds) << " s\n";
   std::cout << "wrote " << o.output << "\n";
   return 0;
 }
@@ -125,14 +181,24 @@ int main(int argc, char** argv) {
   rendering->add_flag("--force", render.force, "Overwrite an existing output file");
   rendering->add_option("--width", render.width, "Image width in pixels")->capture_default_str();
   rendering->add_option("--height", render.height, "Image height in pixels")->capture_default_str();
-  rendering->add_option("--spp", render.spp, "Samples per pixel")->capture_default_str();
+  rendering->add_option("--spp", render.spp, "Samples per pixel (default 64; with --time, the most to take)");
+  rendering->add_option("--time", render.seconds, "Time budget in seconds (finishes the pass running then)");
+  rendering->add_option("--method", render.method, "pt (BRDF sampling), nee (light sampling) or mis (both)")
+      ->capture_default_str();
+  rendering->add_option("--max-depth", render.maxDepth, "Most bounces (Russian roulette ends most paths sooner)")
+      ->capture_default_str();
+  rendering->add_option("--env", render.env, "Constant environment radiance R,G,B (default black)");
+  rendering->add_option("--filter", render.filter, "Pixel filter: box, gaussian or blackman-harris")
+      ->capture_default_str();
+  rendering->add_option("--wavefront", render.wavefront, "Paths in flight (default: chosen for the device)");
+  rendering->add_option("--stats", render.statsFile, "Write render statistics as JSON");
   rendering->add_option("--seed", render.seed, "Random seed")->capture_default_str();
   rendering->add_option("--camera", render.cameraFile, "Camera JSON {eye,target,up,fov_y_deg}");
   rendering->add_option("--eye", render.eye, "Camera position x,y,z");
   rendering->add_option("--target", render.target, "Point the camera looks at x,y,z");
   rendering->add_option("--up", render.up, "Camera up vector x,y,z");
   rendering->add_option("--fov", render.fov, "Vertical field of view in degrees");
-  rendering->add_option("--aov", render.aov, "Debug output: albedo, normal or depth")->capture_default_str();
+  rendering->add_option("--aov", render.aov, "Debug view instead of light transport: albedo, normal or depth");
   rendering->add_option("--device", render.device, "Device: index, list (0,1), type (cpu, gpu, all) or name");
 
   BenchOptions bench;

@@ -38,6 +38,7 @@ class RayCaster {
                     cl::Event* event = nullptr);
 
   const cl::Buffer& nodes() const { return nodes_; }
+  const cl::Buffer& blocks() const { return blocks_; }
   // Triangles in BVH order (three float4 each), for turning hits into surface points.
   const cl::Buffer& triangles() const { return triangles_; }
   // Build options every program that traverses this BVH must use.

@@ -7,7 +7,7 @@
 #define FH_AOV_NORMAL 1
 #define FH_AOV_DEPTH 2
 
-inline float3 geometric_normal(__global const float4* triangles, int t) {
+FH_INLINE float3 geometric_normal(__global const float4* triangles, int t) {
   const float3 v0 = triangles[3 * t].xyz, v1 = triangles[3 * t + 1].xyz, v2 = triangles[3 * t + 2].xyz;
   return normalize(cross(v1 - v0, v2 - v0));
 }

@@ -1,11 +1,39 @@
-// The generate stage: camera rays for a batch of (pixel, sample) pairs. Ray i of the
-// batch is pixel (first_pixel + i) mod pixel_count; sub-pixel offsets are random per
-// (seed, pixel, sample), a box pixel filter.
+// The generate stage: camera rays. generate_paths starts new samples in free path slots
+// and queues them for intersection (the wavefront's refill); generate_camera_rays makes
+// one batch of camera rays for the debug views and the bench.
 #include "camera.h"
+#include "film.h"
+#include "path_state.h"
 #include "rng.h"
 
+// Starts samples first_sample .. first_sample + count - 1 in the slots on top of the
+// free list (free_top entries) and appends them to the ray queue from position
+// queue_base (the host knows both counts, so no atomics are needed). Sample k is pixel
+// k % pixel_count of pass k / pixel_count.
+__kernel void generate_paths(RenderParams params, uint first_sample, uint count, uint free_top,
+                             __global const uint* free_list, __global uint* ray_queue, uint queue_base,
+                             __global const float* filter_table FH_PATH_PARAMS) {
+  const uint i = get_global_id(0);
+  if (i >= count) return;
+  const uint slot = free_list[free_top - 1 - i];
+  const uint k = first_sample + i;
+  const uint pixel = k % params.pixel_count, pass = k / params.pixel_count;
+  const float2 u = pixel_sample_2d(params.seed, pixel, pass);
+  const float px = (float)(pixel % (uint)params.camera.width) + 0.5f +
+                   filter_offset(filter_table, params.filter_table_size, u.x);
+  const float py = (float)(pixel / (uint)params.camera.width) + 0.5f +
+                   filter_offset(filter_table, params.filter_table_size, u.y);
+  ray_org[slot] = (float4)(vload3(0, params.camera.origin), 0.0f);
+  ray_dir[slot] = (float4)(camera_ray_direction(&params.camera, px, py), INFINITY);
+  throughput[slot] = (float4)(1.0f, 1.0f, 1.0f, 0.0f);
+  radiance[slot] = (float4)(0.0f);
+  sample_id[slot] = k;
+  depth[slot] = 0;
+  ray_queue[queue_base + i] = slot;
+}
+
 __kernel void generate_camera_rays(CameraParams cam, uint seed, uint sample_index, uint first_pixel,
-                                   __global float4* ray_org, __global float4* ray_dir, __global uint* ray_pixel,
+                                   __global float4* out_org, __global float4* out_dir, __global uint* out_pixel,
                                    uint ray_count) {
   const uint i = get_global_id(0);
   if (i >= ray_count) return;
@@ -14,7 +42,7 @@ __kernel void generate_camera_rays(CameraParams cam, uint seed, uint sample_inde
   const uint stream = hash_combine(pixel, sample_index);
   const float jx = random_float(seed, stream, 0), jy = random_float(seed, stream, 1);
   const float px = (float)(pixel % (uint)cam.width) + jx, py = (float)(pixel / (uint)cam.width) + jy;
-  ray_org[i] = (float4)(vload3(0, cam.origin), 0.0f);
-  ray_dir[i] = (float4)(camera_ray_direction(&cam, px, py), INFINITY);
-  ray_pixel[i] = pixel;
+  out_org[i] = (float4)(vload3(0, cam.origin), 0.0f);
+  out_dir[i] = (float4)(camera_ray_direction(&cam, px, py), INFINITY);
+  out_pixel[i] = pixel;
 }

@@ -11,10 +11,6 @@
 // the other, opening cracks along shared edges.
 #pragma OPENCL FP_CONTRACT OFF
 
-// The traversal's helpers must be inlined into the kernel: called out of line they pass
-// the ray and the stack through memory (PoCL's LLVM declines to inline them by itself).
-#define FH_INLINE inline __attribute__((always_inline))
-
 // The host passes the stack depth its BVH needs (7 per wide level + 1) as a build option.
 #ifndef FH_TRAVERSAL_STACK
 #define FH_TRAVERSAL_STACK 64

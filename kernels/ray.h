@@ -9,11 +9,13 @@
 #ifndef FH_RAY_H
 #define FH_RAY_H
 
+#include "types.h"
+
 // 2^-16 of the magnitude: ~128 ulps of the largest coordinate, well above the error of
 // the interpolated point and of the watertight test's sheared coordinates.
 #define FH_OFFSET_SCALE (1.0f / 65536.0f)
 
-inline float max_component(float3 v) { return fmax(fmax(v.x, v.y), v.z); }
+FH_INLINE float max_component(float3 v) { return fmax(fmax(v.x, v.y), v.z); }
 
 typedef struct {
   float3 position;
@@ -21,7 +23,7 @@ typedef struct {
   float magnitude;   // largest |coordinate| of the triangle's vertices and the point
 } SurfacePoint;
 
-inline SurfacePoint surface_point(__global const float4* triangles, int t, float b1, float b2) {
+FH_INLINE SurfacePoint surface_point(__global const float4* triangles, int t, float b1, float b2) {
   const float3 v0 = triangles[3 * t].xyz, v1 = triangles[3 * t + 1].xyz, v2 = triangles[3 * t + 2].xyz;
   SurfacePoint s;
   s.position = (1.0f - b1 - b2) * v0 + b1 * v1 + b2 * v2;
@@ -31,7 +33,7 @@ inline SurfacePoint surface_point(__global const float4* triangles, int t, float
 }
 
 // The origin for a ray leaving the surface on the side `side` (any vector on that side).
-inline float3 offset_ray_origin(const SurfacePoint* s, float3 side) {
+FH_INLINE float3 offset_ray_origin(const SurfacePoint* s, float3 side) {
   const float3 n = dot(s->normal, side) >= 0.0f ? s->normal : -s->normal;
   return s->position + n * (FH_OFFSET_SCALE * s->magnitude);
 }

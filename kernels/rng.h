@@ -3,20 +3,29 @@
 #ifndef FH_RNG_H
 #define FH_RNG_H
 
+#include "types.h"
+
 // PCG-style 32-bit hash (a good avalanche for small, structured inputs).
-inline uint hash_u32(uint x) {
+FH_INLINE uint hash_u32(uint x) {
   uint state = x * 747796405u + 2891336453u;
   uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
   return (word >> 22u) ^ word;
 }
 
-inline uint hash_combine(uint a, uint b) { return hash_u32(a ^ (b + 0x9e3779b9u + (a << 6) + (a >> 2))); }
+FH_INLINE uint hash_combine(uint a, uint b) { return hash_u32(a ^ (b + 0x9e3779b9u + (a << 6) + (a >> 2))); }
 
 // A float in [0, 1) from the top 24 bits.
-inline float u32_to_unit_float(uint x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
+FH_INLINE float u32_to_unit_float(uint x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
 
-inline float random_float(uint seed, uint stream, uint dimension) {
-  return u32_to_unit_float(hash_combine(hash_combine(seed, stream), dimension));
+// One stream of numbers per (seed, stream), e.g. per sample: hash it once per kernel and
+// draw its dimensions with random_in_stream.
+FH_INLINE uint rng_stream(uint seed, uint stream) { return hash_combine(seed, stream); }
+FH_INLINE float random_in_stream(uint stream, uint dimension) {
+  return u32_to_unit_float(hash_combine(stream, dimension));
+}
+
+FH_INLINE float random_float(uint seed, uint stream, uint dimension) {
+  return random_in_stream(rng_stream(seed, stream), dimension);
 }
 
 #endif

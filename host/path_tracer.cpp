@@ -1,0 +1,334 @@
+// The host side of the wavefront path tracer: it reads like the pipeline it drives.
+#include "path_tracer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "../kernels/path_state.h"
+#include "render_aov.h"
+
+namespace fh {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr int kFilterTableSize = 256;
+
+// Sets the path-state buffers as a kernel's trailing arguments, in FH_PATH_FIELDS order.
+void setPathArgs(cl::Kernel& kernel, cl_uint first, const std::vector<cl::Buffer>& state) {
+  for (size_t i = 0; i < state.size(); ++i) FH_CL(kernel.setArg(first + cl_uint(i), state[i]));
+}
+
+template <typename... Args>
+void setArgs(cl::Kernel& kernel, const Args&... args) {
+  cl_uint index = 0;
+  (FH_CL(kernel.setArg(index++, args)), ...);
+}
+
+double filterValue(PixelFilter f, double x, double radius) {
+  switch (f) {
+    case PixelFilter::Box:
+      return 1.0;
+    case PixelFilter::Gaussian: {  // sigma 0.5, shifted to reach zero at the radius
+      const double sigma = 0.5;
+      return std::max(0.0, std::exp(-x * x / (2 * sigma * sigma)) - std::exp(-radius * radius / (2 * sigma * sigma)));
+    }
+    case PixelFilter::BlackmanHarris: {
+      const double t = (x + radius) / (2.0 * radius);  // 0..1 over the support
+      return 0.35875 - 0.48829 * std::cos(2 * M_PI * t) + 0.14128 * std::cos(4 * M_PI * t) -
+             0.01168 * std::cos(6 * M_PI * t);
+    }
+  }
+  return 1.0;
+}
+
+}  // namespace
+
+Method parseMethod(const std::string& name) {
+  if (name == "pt") return Method::PT;
+  if (name == "nee") return Method::NEE;
+  if (name == "mis") return Method::MIS;
+  throw Error("--method '" + name + "': unknown method (use pt, nee or mis)");
+}
+
+const char* methodName(Method m) { return m == Method::PT ? "pt" : m == Method::NEE ? "nee" : "mis"; }
+
+PixelFilter parseFilter(const std::string& name) {
+  if (name == "box") return PixelFilter::Box;
+  if (name == "gaussian") return PixelFilter::Gaussian;
+  if (name == "blackman-harris") return PixelFilter::BlackmanHarris;
+  throw Error("--filter '" + name + "': unknown filter (use box, gaussian or blackman-harris)");
+}
+
+const char* filterName(PixelFilter f) {
+  return f == PixelFilter::Box ? "box" : f == PixelFilter::Gaussian ? "gaussian" : "blackman-harris";
+}
+
+std::vector<float> filterInverseCdf(PixelFilter filter, int size, float* radius) {
+  const double r = filter == PixelFilter::Box ? 0.5 : filter == PixelFilter::Gaussian ? 1.5 : 2.0;
+  *radius = float(r);
+  // Integrate the filter finely, then invert the CDF at `size` evenly spaced values.
+  const int steps = 4096;
+  std::vector<double> cdf(steps + 1, 0.0);
+  for (int i = 0; i < steps; ++i) {
+    const double x = -r + (i + 0.5) * 2 * r / steps;
+    cdf[size_t(i) + 1] = cdf[size_t(i)] + filterValue(filter, x, r);
+  }
+  std::vector<float> table(static_cast<size_t>(size));
+  for (int j = 0; j < size; ++j) {
+    const double target = cdf.back() * j / (size - 1);
+    const auto it = std::lower_bound(cdf.begin(), cdf.end(), target);
+    const size_t i = size_t(std::max<std::ptrdiff_t>(1, it - cdf.begin()));
+    const double f = (target - cdf[i - 1]) / std::max(cdf[i] - cdf[i - 1], 1e-300);
+    table[size_t(j)] = float(-r + (double(i - 1) + std::clamp(f, 0.0, 1.0)) * 2 * r / steps);
+  }
+  return table;
+}
+
+Image Film::image() const {
+  Image img;
+  img.width = width;
+  img.height = height;
+  img.rgb.resize(size_t(width) * size_t(height) * 3);
+  for (size_t p = 0; p < size_t(width) * size_t(height); ++p)
+    for (size_t c = 0; c < 3; ++c) img.rgb[3 * p + c] = sum[4 * p + 3] > 0.f ? sum[4 * p + c] / sum[4 * p + 3] : 0.f;
+  return img;
+}
+
+std::array<double, 3> Film::varianceOfMean(size_t p) const {
+  const double n = sum[4 * p + 3];
+  std::array<double, 3> v{0, 0, 0};
+  if (n < 2) return v;
+  for (size_t c = 0; c < 3; ++c) {
+    const double mean = sum[4 * p + c] / n;
+    const double sampleVariance = std::max(0.0, (sumSq[4 * p + c] - n * mean * mean) / (n - 1));
+    v[c] = sampleVariance / n;
+  }
+  return v;
+}
+
+std::string statsJson(const RenderStats& st, const RenderSettings& s) {
+  nlohmann::json kernels = nlohmann::json::object();
+  double kernelTotal = 0.0;
+  for (const auto& [name, seconds] : st.kernelSeconds) kernelTotal += seconds;
+  for (const auto& [name, seconds] : st.kernelSeconds)
+    kernels[name] = {{"seconds", seconds}, {"share", kernelTotal > 0 ? seconds / kernelTotal : 0.0}};
+  const uint64_t rays = st.cameraRays + st.bounceRays + st.shadowRays;
+  nlohmann::json doc = {
+      {"samples", st.samples},
+      {"seconds", st.seconds},
+      {"samples_per_second", st.seconds > 0 ? double(st.samples) / st.seconds : 0.0},
+      {"nonfinite_samples", st.nonfinite},
+      {"devices", nlohmann::json::array({{{"name", st.device}, {"samples", st.samples}}})},
+      {"method", methodName(s.method)},
+      {"width", s.width},
+      {"height", s.height},
+      {"spp", s.width * s.height > 0 ? double(st.samples) / (double(s.width) * s.height) : 0.0},
+      {"seed", s.seed},
+      {"max_depth", s.maxDepth},
+      {"filter", filterName(s.filter)},
+      {"wavefront", st.wavefront},
+      {"iterations", st.iterations},
+      {"queue_occupancy", st.meanQueueOccupancy},
+      {"rays", {{"camera", st.cameraRays}, {"bounce", st.bounceRays}, {"shadow", st.shadowRays}, {"total", rays}}},
+      {"rays_per_second", st.seconds > 0 ? double(rays) / st.seconds : 0.0},
+      {"kernels", kernels}};
+  return doc.dump(2);
+}
+
+size_t defaultWavefront(const DeviceInfo& device, size_t pixels) {
+  const size_t preferred = device.type == "gpu" ? (size_t(1) << 20) : (size_t(1) << 16);
+  return std::max<size_t>(kLocalSize, std::min(preferred, 2 * pixels));
+}
+
+PathTracer::PathTracer(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const Camera& camera,
+                       const RenderSettings& s)
+    : dc_(dc), settings_(s), scene_(dc, scene, bvh) {
+  if (s.width <= 0 || s.height <= 0) throw Error("--width/--height must be positive");
+  pixels_ = unsigned(s.width) * unsigned(s.height);
+  wavefront_ = s.wavefront ? s.wavefront : defaultWavefront(dc.info, pixels_);
+
+  params_.camera = makeCameraParams(camera, s.width, s.height);
+  for (size_t c = 0; c < 3; ++c) params_.env[c] = s.env[c];
+  params_.seed = s.seed;
+  params_.pixel_count = pixels_;
+  params_.max_depth = unsigned(s.maxDepth);
+  params_.rr_depth = unsigned(s.rrDepth);
+  params_.light_count = scene_.lightCount;
+  const std::vector<float> table = filterInverseCdf(s.filter, kFilterTableSize, &params_.filter_radius);
+  params_.filter_table_size = unsigned(table.size());
+
+  // Enough passes in flight that the wavefront stays full while a pass's longest paths
+  // finish: pass buffers cost a frame each, so only as many as the wavefront needs.
+  passSlots_ = unsigned(std::min<size_t>(FH_MAX_PASS_SLOTS, 2 + (2 * wavefront_ + pixels_ - 1) / pixels_));
+  const std::string options = scene_.caster.traversalOptions() + " -DFH_PASS_SLOTS=" + std::to_string(passSlots_) +
+                              " -DFH_METHOD_" +
+                              (s.method == Method::PT ? "PT" : s.method == Method::NEE ? "NEE" : "MIS");
+  const cl::Program program =
+      buildProgram(dc.context, dc.info.device,
+                   {"generate.cl", "intersect.cl", "shade.cl", "shadow_connect.cl", "accumulate.cl"}, options);
+  generate_ = createKernel(program, "generate_paths");
+  intersect_ = createKernel(program, "intersect_paths");
+  shade_ = createKernel(program, "shade");
+  shadowConnect_ = createKernel(program, "shadow_connect");
+  accumulatePaths_ = createKernel(program, "accumulate_paths");
+  accumulatePass_ = createKernel(program, "accumulate_pass");
+
+  auto buffer = [&](size_t bytes, const char* what, const void* host = nullptr) {
+    return allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, bytes, what, host);
+  };
+#define FH_ALLOCATE_FIELD(type, name, bytes) pathState_.push_back(buffer(wavefront_ * (bytes), "path state " #name));
+  FH_PATH_FIELDS(FH_ALLOCATE_FIELD)
+#undef FH_ALLOCATE_FIELD
+#define FH_ALLOCATE_FIELD(type, name, bytes) shadowRequests_.push_back(buffer(wavefront_ * (bytes), #name));
+  FH_SHADOW_FIELDS(FH_ALLOCATE_FIELD)
+#undef FH_ALLOCATE_FIELD
+  for (auto& q : rayQueue_) q = buffer(wavefront_ * 4, "ray queue");
+  finishedQueue_ = buffer(wavefront_ * 4, "finished queue");
+  std::vector<unsigned> allFree(wavefront_);
+  for (size_t i = 0; i < wavefront_; ++i) allFree[i] = unsigned(i);
+  freeList_ = buffer(wavefront_ * 4, "free list", allFree.data());
+  counters_ = buffer(FH_COUNT_TOTAL * 4, "queue counters");
+  passBuffer_ = buffer(size_t(passSlots_) * pixels_ * 16, "pass buffers");
+  filmSum_ = buffer(size_t(pixels_) * 16, "film");
+  filmSumSq_ = buffer(size_t(pixels_) * 16, "film squares");
+  filterTable_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, table.size() * 4, "filter table",
+                                table.data());
+  FH_CL(dc.queue.enqueueFillBuffer(passBuffer_, 0u, 0, size_t(passSlots_) * pixels_ * 16));
+  FH_CL(dc.queue.enqueueFillBuffer(filmSum_, 0u, 0, size_t(pixels_) * 16));
+  FH_CL(dc.queue.enqueueFillBuffer(filmSumSq_, 0u, 0, size_t(pixels_) * 16));
+  FH_CL(dc.queue.enqueueFillBuffer(counters_, 0u, 0, FH_COUNT_TOTAL * 4));
+}
+
+void PathTracer::timeKernel(const char* name, const cl::Event& event) {
+  cl_ulong start = 0, end = 0;
+  FH_CL(event.getProfilingInfo(CL_PROFILING_COMMAND_START, &start));
+  FH_CL(event.getProfilingInfo(CL_PROFILING_COMMAND_END, &end));
+  stats_.kernelSeconds[name] += double(end - start) * 1e-9;
+}
+
+// One wavefront iteration over every path in flight: the five stages in order.
+void PathTracer::runIteration(unsigned generateCount, unsigned firstSample, unsigned freeTop, unsigned rayCount,
+                              int current) {
+  const unsigned capacity = rayCount + generateCount;  // rays after generate
+  const int next = 1 - current;
+  const unsigned nextCounter = current == 0 ? FH_COUNT_RAYS_B : FH_COUNT_RAYS_A;
+  auto run = [&](cl::Kernel& k, size_t n, const char* name) {
+    if (n == 0) return;
+    cl::Event e;
+    launch(dc_, k, n, name, &e);
+    events_.emplace_back(name, e);
+  };
+
+  setArgs(generate_, params_, firstSample, generateCount, freeTop, freeList_, rayQueue_[current], rayCount,
+          filterTable_);
+  setPathArgs(generate_, 8, pathState_);
+  run(generate_, generateCount, "generate");
+
+  setArgs(intersect_, scene_.caster.nodes(), scene_.caster.blocks(), rayQueue_[current], capacity, pathState_[0],
+          pathState_[1], pathState_[2]);
+  run(intersect_, capacity, "intersect");
+
+  setArgs(shade_, params_, rayQueue_[current], capacity, rayQueue_[next], finishedQueue_, counters_, nextCounter,
+          scene_.caster.triangles(), scene_.triangleMaterial, scene_.materials, scene_.lightPdfArea);
+  setPathArgs(shade_, 11, pathState_);
+  setPathArgs(shade_, cl_uint(11 + pathState_.size()), shadowRequests_);
+  run(shade_, capacity, "shade");
+
+  if (settings_.method != Method::PT && scene_.lightCount > 0) {
+    setArgs(shadowConnect_, params_, capacity, counters_, scene_.caster.nodes(), scene_.caster.blocks(),
+            scene_.caster.triangles(), scene_.triangleMaterial, scene_.materials, scene_.lightCdf,
+            scene_.lightTriangle, scene_.lightPdfArea);
+    setPathArgs(shadowConnect_, 11, pathState_);
+    setPathArgs(shadowConnect_, cl_uint(11 + pathState_.size()), shadowRequests_);
+    run(shadowConnect_, capacity, "shadow_connect");
+  }
+
+  setArgs(accumulatePaths_, finishedQueue_, capacity, counters_, freeList_, freeTop - generateCount, pixels_,
+          passBuffer_);
+  setPathArgs(accumulatePaths_, 7, pathState_);
+  run(accumulatePaths_, capacity, "accumulate");
+}
+
+// Adds every completed pass to the film, in pass order.
+void PathTracer::foldCompletedPasses(uint32_t* counters, uint64_t& passesDone, uint64_t samplesStarted) {
+  for (;;) {
+    const unsigned slot = unsigned(passesDone % passSlots_);
+    if (counters[FH_COUNT_PASS_DONE + slot] != pixels_ || passesDone * pixels_ >= samplesStarted) return;
+    setArgs(accumulatePass_, passBuffer_, unsigned(passesDone), pixels_, filmSum_, filmSumSq_);
+    cl::Event e;
+    launch(dc_, accumulatePass_, pixels_, "accumulate_pass", &e);
+    const uint32_t zero = 0;
+    FH_CL(dc_.queue.enqueueWriteBuffer(counters_, CL_TRUE, (FH_COUNT_PASS_DONE + slot) * 4, 4, &zero));
+    timeKernel("accumulate", e);
+    counters[FH_COUNT_PASS_DONE + slot] = 0;
+    ++passesDone;
+  }
+}
+
+Film PathTracer::render() {
+  const auto start = Clock::now();
+  const uint64_t pixels = pixels_;
+  const uint64_t maxSamples = uint64_t(std::max(1, settings_.spp)) * pixels;
+  uint64_t limit = maxSamples;  // shrinks to the end of the running pass when time is up
+  uint64_t nextSample = 0, passesDone = 0, rayQueueSum = 0;
+  unsigned freeCount = unsigned(wavefront_), rayCount = 0;
+  int current = 0;
+  Progress progress(settings_.progress);
+  stats_ = RenderStats{};
+  stats_.device = dc_.info.name;
+  stats_.wavefront = wavefront_;
+  uint32_t counters[FH_COUNT_TOTAL] = {};
+
+  while (passesDone * pixels < limit) {
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    if (settings_.seconds > 0.0 && elapsed >= settings_.seconds && limit == maxSamples)
+      limit = std::max<uint64_t>(1, (nextSample + pixels - 1) / pixels) * pixels;
+    // Pass p + passSlots reuses pass p's buffer: it may start once pass p is folded in.
+    const uint64_t allowed = std::min(limit, (passesDone + passSlots_) * pixels);
+    const unsigned generate = unsigned(std::min<uint64_t>(freeCount, allowed - std::min(allowed, nextSample)));
+
+    // Queue lengths for this iteration: generate appends after the rays already queued.
+    counters[current == 0 ? FH_COUNT_RAYS_A : FH_COUNT_RAYS_B] = rayCount + generate;
+    counters[current == 0 ? FH_COUNT_RAYS_B : FH_COUNT_RAYS_A] = 0;
+    counters[FH_COUNT_SHADOW] = counters[FH_COUNT_FINISHED] = 0;
+    FH_CL(dc_.queue.enqueueWriteBuffer(counters_, CL_FALSE, 0, 4 * 4, counters));
+    if (generate + rayCount > 0) runIteration(generate, unsigned(nextSample), freeCount, rayCount, current);
+    nextSample += generate;
+    stats_.cameraRays += generate;
+    rayQueueSum += generate + rayCount;
+    ++stats_.iterations;
+
+    FH_CL(dc_.queue.enqueueReadBuffer(counters_, CL_TRUE, 0, sizeof counters, counters));
+    for (const auto& [name, event] : events_) timeKernel(name, event);
+    events_.clear();
+    current = 1 - current;
+    rayCount = counters[current == 0 ? FH_COUNT_RAYS_A : FH_COUNT_RAYS_B];
+    freeCount = freeCount - generate + counters[FH_COUNT_FINISHED];
+    stats_.bounceRays += rayCount;
+    stats_.shadowRays += counters[FH_COUNT_SHADOW];
+
+    foldCompletedPasses(counters, passesDone, nextSample);
+    progress.update(passesDone * pixels, settings_.seconds > 0.0 ? 0 : maxSamples,
+                    std::chrono::duration<double>(Clock::now() - start).count(),
+                    settings_.seconds > 0.0 ? std::min(1.0, elapsed / settings_.seconds) : 0.0);
+  }
+
+  Film film;
+  film.width = settings_.width;
+  film.height = settings_.height;
+  film.sum.resize(size_t(pixels) * 4);
+  film.sumSq.resize(size_t(pixels) * 4);
+  FH_CL(dc_.queue.enqueueReadBuffer(filmSum_, CL_TRUE, 0, film.sum.size() * 4, film.sum.data()));
+  FH_CL(dc_.queue.enqueueReadBuffer(filmSumSq_, CL_TRUE, 0, film.sumSq.size() * 4, film.sumSq.data()));
+  stats_.samples = passesDone * pixels;
+  stats_.nonfinite = counters[FH_COUNT_NONFINITE];
+  stats_.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  stats_.meanQueueOccupancy = stats_.iterations ? double(rayQueueSum) / double(stats_.iterations * wavefront_) : 0.0;
+  progress.finish(stats_.samples, stats_.seconds);
+  return film;
+}
+
+}  // namespace fh

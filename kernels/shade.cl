@@ -1,0 +1,122 @@
+// The shade stage, for every path whose ray was just intersected:
+//   escaped       -> add the environment, finish;
+//   emitter hit   -> add Ke where the method counts it (with the MIS weight for mis);
+//   light sample  -> queue a next-event request for shadow_connect (nee, mis);
+//   BSDF sample   -> the next direction, throughput update, Russian roulette, requeue.
+// Build options choose the method: FH_METHOD_PT, FH_METHOD_NEE or FH_METHOD_MIS.
+#include "bsdf.h"
+#include "lights.h"
+#include "path_state.h"
+#include "ray.h"
+#include "rng.h"
+
+#if !defined(FH_METHOD_PT) && !defined(FH_METHOD_NEE) && !defined(FH_METHOD_MIS)
+#error "build with -DFH_METHOD_PT, -DFH_METHOD_NEE or -DFH_METHOD_MIS"
+#endif
+
+// Random dimensions per bounce (the counter-based RNG needs no state).
+#define FH_DIMS_PER_BOUNCE 8
+#define FH_DIM_BSDF_U1 0
+#define FH_DIM_BSDF_U2 1
+#define FH_DIM_ROULETTE 2
+
+// The weight of emission found by BSDF sampling at a vertex `depth` bounces from the camera.
+FH_INLINE float emission_weight(uint depth, float bsdf_pdf, float light_pdf_area, float dist2, float cos_light) {
+#if defined(FH_METHOD_PT)
+  return 1.0f;
+#elif defined(FH_METHOD_NEE)
+  return depth == 0 ? 1.0f : 0.0f;  // light sampling already counted it
+#else
+  if (depth == 0) return 1.0f;
+  return power_heuristic(bsdf_pdf, area_to_solid_angle(light_pdf_area, dist2, cos_light));
+#endif
+}
+
+__kernel void shade(RenderParams params, __global const uint* ray_queue, uint count, __global uint* next_queue,
+                    __global uint* finished_queue, volatile __global uint* counters, uint next_counter,
+                    __global const float4* triangles, __global const int* triangle_material,
+                    __global const GpuMaterial* materials, __global const float* light_pdf_area
+                        FH_PATH_PARAMS FH_SHADOW_PARAMS) {
+  volatile __local uint scratch[2];
+  const uint i = get_global_id(0);
+  bool continues = false, light_sample = false, finishes = false;
+  uint p = 0;
+  // What a light-sample request needs, kept until its queue position is known.
+  float4 request_position = (float4)(0.0f), request_normal = (float4)(0.0f), request_beta = (float4)(0.0f);
+
+  if (i < count) {
+    p = ray_queue[i];
+    const float4 h = hit[p];
+    const float3 dir = ray_dir[p].xyz;
+    float4 beta = throughput[p];
+    float3 gathered = radiance[p].xyz;
+    const uint bounce = depth[p];
+    const int t = as_int(h.w);
+
+    if (t < 0) {
+      gathered += beta.xyz * vload3(0, params.env);
+    } else {
+      const SurfacePoint s = surface_point(triangles, t, h.y, h.z);
+      const int material_id = triangle_material[t];
+      __global const GpuMaterial* m = materials + material_id;
+      const float3 wo = -dir;
+      const float cos_front = dot(s.normal, wo);
+
+      // Emission leaves the front (counter-clockwise) side only.
+      const float3 ke = vload3(0, m->ke);
+      if (cos_front > 0.0f && (ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f))
+        gathered += beta.xyz * ke * emission_weight(bounce, beta.w, light_pdf_area[t], h.x * h.x, cos_front);
+
+      // Two-sided shading: the normal on the viewer's side.
+      const float3 n = cos_front >= 0.0f ? s.normal : -s.normal;
+      const bool may_bounce = bounce + 1 <= params.max_depth;
+
+#if !defined(FH_METHOD_PT)
+      light_sample = may_bounce && params.light_count > 0;
+      request_position = (float4)(s.position, s.magnitude);
+      request_normal = (float4)(n, as_float(material_id));
+      request_beta = (float4)(beta.xyz, as_float(bounce));
+#endif
+
+      if (may_bounce) {
+        const uint dim = bounce * FH_DIMS_PER_BOUNCE;
+        const uint rng = rng_stream(params.seed, sample_id[p]);
+        const Bsdf bsdf = material_bsdf(m);
+        float3 wi;
+        float pdf;
+        const float3 weight = bsdf_sample(&bsdf, n, random_in_stream(rng, dim + FH_DIM_BSDF_U1),
+                                          random_in_stream(rng, dim + FH_DIM_BSDF_U2), &wi, &pdf);
+        beta = (float4)(beta.xyz * weight, pdf);
+        continues = pdf > 0.0f;
+        // Russian roulette: survive with a probability from the throughput (capped, so
+        // bright paths still end); dividing by it keeps the estimator unbiased.
+        if (continues && bounce + 1 >= params.rr_depth) {
+          const float survive = fmin(fmax(fmax(beta.x, beta.y), beta.z), 0.95f);
+          if (random_in_stream(rng, dim + FH_DIM_ROULETTE) >= survive) continues = false;
+          else beta.xyz /= survive;
+        }
+        continues = continues && (beta.x > 0.0f || beta.y > 0.0f || beta.z > 0.0f);
+        if (continues) {
+          ray_org[p] = (float4)(offset_ray_origin(&s, wi), 0.0f);
+          ray_dir[p] = (float4)(wi, INFINITY);
+          throughput[p] = beta;
+          depth[p] = bounce + 1;
+        }
+      }
+    }
+    radiance[p] = (float4)(gathered, 0.0f);
+    finishes = !continues;
+  }
+
+  const uint next = group_append(continues, &counters[next_counter], scratch);
+  if (continues) next_queue[next] = p;
+  const uint request = group_append(light_sample, &counters[FH_COUNT_SHADOW], scratch);
+  if (light_sample) {
+    shadow_path[request] = p;
+    shadow_position[request] = request_position;
+    shadow_normal[request] = request_normal;
+    shadow_throughput[request] = request_beta;
+  }
+  const uint done = group_append(finishes, &counters[FH_COUNT_FINISHED], scratch);
+  if (finishes) finished_queue[done] = p;
+}

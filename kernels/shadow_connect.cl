@@ -1,0 +1,66 @@
+// The shadow-connect stage: next-event estimation for each light-sample request that
+// shade queued. Picks an emissive triangle in proportion to its power and a uniform point
+// on it (the area formulation: G(x,y) and V(x,y)), traces the shadow ray, and adds the
+// unoccluded contribution, weighted against BSDF sampling for mis.
+#include "bsdf.h"
+#include "intersect.h"
+#include "lights.h"
+#include "path_state.h"
+#include "ray.h"
+#include "rng.h"
+#include "sampling.h"
+
+#define FH_DIMS_PER_BOUNCE 8
+#define FH_DIM_LIGHT_PICK 3
+#define FH_DIM_LIGHT_U1 4
+#define FH_DIM_LIGHT_U2 5
+
+__kernel void shadow_connect(RenderParams params, uint capacity, volatile __global uint* counters,
+                             __global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
+                             __global const float4* triangles, __global const int* triangle_material,
+                             __global const GpuMaterial* materials, __global const float* light_cdf,
+                             __global const int* light_triangle, __global const float* light_pdf_area
+                                 FH_PATH_PARAMS FH_SHADOW_PARAMS) {
+  const uint i = get_global_id(0);
+  if (i >= capacity || i >= counters[FH_COUNT_SHADOW]) return;
+  const uint p = shadow_path[i];
+  const float4 position = shadow_position[i], normal = shadow_normal[i];
+  SurfacePoint s;
+  s.position = position.xyz;
+  s.magnitude = position.w;
+  s.normal = normal.xyz;  // already on the viewer's side
+  const float4 beta = shadow_throughput[i];  // w: the bounce count at the shading point
+  const uint rng = rng_stream(params.seed, sample_id[p]), dim = (uint)as_int(beta.w) * FH_DIMS_PER_BOUNCE;
+
+  const uint light = pick_light(light_cdf, params.light_count, random_in_stream(rng, dim + FH_DIM_LIGHT_PICK));
+  const int lt = light_triangle[light];
+  const float2 b = sample_triangle(random_in_stream(rng, dim + FH_DIM_LIGHT_U1),
+                                   random_in_stream(rng, dim + FH_DIM_LIGHT_U2));
+  const SurfacePoint l = surface_point(triangles, lt, b.x, b.y);
+  const float3 to_light = l.position - s.position;
+  const float dist2 = dot(to_light, to_light);
+  if (!(dist2 > 0.0f)) return;
+  const float3 wi = to_light * rsqrt(dist2);
+  const float cos_surface = dot(s.normal, wi), cos_light = -dot(l.normal, wi);
+  if (cos_surface <= 0.0f || cos_light <= 0.0f) return;  // behind the surface, or the light's back
+
+  const Bsdf bsdf = material_bsdf(materials + as_int(normal.w));
+  const float3 f = bsdf_eval(&bsdf, s.normal, wi);
+  const float pdf_light = area_to_solid_angle(light_pdf_area[lt], dist2, cos_light);
+#if defined(FH_METHOD_MIS)
+  const float weight = power_heuristic(pdf_light, bsdf_pdf(s.normal, wi));
+#else
+  const float weight = 1.0f;
+#endif
+  const float3 ke = vload3(0, materials[triangle_material[lt]].ke);
+  const float3 contribution = beta.xyz * f * ke * (cos_surface * weight / pdf_light);
+  if (!(contribution.x > 0.0f || contribution.y > 0.0f || contribution.z > 0.0f)) return;
+
+  // V(x, y): the segment from just off the surface to just short of the light point.
+  const float3 origin = offset_ray_origin(&s, wi);
+  const float3 target = offset_ray_origin(&l, -wi);
+  const float3 d = target - origin;
+  const float dist = length(d);
+  if (trace_ray(nodes, blocks, origin, d / dist, 0.0f, dist * FH_SHADOW_SHORTEN, true).triangle >= 0) return;
+  radiance[p] += (float4)(contribution, 0.0f);
+}
