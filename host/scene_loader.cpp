@@ -111,24 +111,6 @@ void addTextures(Scene& scene, const std::vector<tinyobj::material_t>& source, c
   }
 }
 
-void collectLights(Scene& scene) {
-  size_t zeroArea = 0;
-  for (size_t t = 0; t < scene.triangleCount(); ++t) {
-    const Material& m = scene.materials[size_t(scene.triangleMaterial[t])];
-    if (!m.isEmissive()) continue;
-    const float3 a = scene.corner(t, 0), b = scene.corner(t, 1), c = scene.corner(t, 2);
-    const float area = 0.5f * length(cross(b - a, c - a));
-    if (!(area > 0.f)) {
-      ++zeroArea;
-      continue;
-    }
-    const float k = float(M_PI) * area;
-    scene.lights.push_back({unsigned(t), area, {k * m.ke[0], k * m.ke[1], k * m.ke[2]}});
-  }
-  if (zeroArea)
-    scene.warnings.push_back(std::to_string(zeroArea) + " emissive triangle(s) have zero area and emit nothing");
-  if (scene.lights.empty()) scene.warnings.push_back("the scene has no emissive triangles (no Ke): it has no lights");
-}
 
 void flattenShapes(Scene& scene, const tinyobj::attrib_t& attrib, const std::vector<tinyobj::shape_t>& shapes,
                    int defaultMaterial) {
@@ -212,6 +194,25 @@ Scene buildScene(const SceneText& text, const ObjLintReport& report) {
 }
 
 }  // namespace
+
+void collectLights(Scene& scene) {
+  size_t zeroArea = 0;
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    const Material& m = scene.materials[size_t(scene.triangleMaterial[t])];
+    if (!m.isEmissive()) continue;
+    const float3 a = scene.corner(t, 0), b = scene.corner(t, 1), c = scene.corner(t, 2);
+    const float area = 0.5f * length(cross(b - a, c - a));
+    if (!(area > 0.f)) {
+      ++zeroArea;
+      continue;
+    }
+    const float k = float(M_PI) * area;
+    scene.lights.push_back({unsigned(t), area, {k * m.ke[0], k * m.ke[1], k * m.ke[2]}});
+  }
+  if (zeroArea)
+    scene.warnings.push_back(std::to_string(zeroArea) + " emissive triangle(s) have zero area and emit nothing");
+  if (scene.lights.empty()) scene.warnings.push_back("the scene has no emissive triangles (no Ke): it has no lights");
+}
 
 void Scene::bounds(Vec3f& lo, Vec3f& hi) const {
   lo = {INFINITY, INFINITY, INFINITY};

@@ -13,4 +13,7 @@ Scene loadScene(const std::string& objPath);
 // The built-in Cornell box (embedded in the binary).
 Scene loadDefaultScene();
 
+// Fills Scene::lights from the emissive triangles (for scenes built in code).
+void collectLights(Scene& scene);
+
 }  // namespace fh

@@ -1,0 +1,59 @@
+// Scenes built in code for closed-form tests: quads and boxes with chosen materials.
+#pragma once
+#include "scene.h"
+#include "scene_loader.h"
+#include "vec.h"
+
+namespace fh::test {
+
+class SceneBuilder {
+ public:
+  // A material with diffuse albedo `kd` and emitted radiance `ke` (grey values).
+  int material(float kd, float ke = 0.f) {
+    Material m;
+    m.name = "m" + std::to_string(scene_.materials.size());
+    m.kd = {kd, kd, kd};
+    m.ke = {ke, ke, ke};
+    scene_.materials.push_back(m);
+    return int(scene_.materials.size() - 1);
+  }
+
+  // Quad a b c d, counter-clockwise as seen from its front.
+  void quad(const float3& a, const float3& b, const float3& c, const float3& d, int material) {
+    const unsigned base = unsigned(scene_.vertexCount());
+    for (const float3& p : {a, b, c, d}) scene_.positions.insert(scene_.positions.end(), p.begin(), p.end());
+    for (unsigned k : {0u, 1u, 2u, 0u, 2u, 3u}) scene_.indices.push_back(base + k);
+    scene_.triangleMaterial.insert(scene_.triangleMaterial.end(), {material, material});
+  }
+
+  // Quad a b c d wound so that its front faces toward `toward`.
+  void quadFacing(const float3& a, const float3& b, const float3& c, const float3& d, const float3& toward,
+                  int material) {
+    if (dot(cross(b - a, c - a), toward - a) >= 0.f) quad(a, b, c, d, material);
+    else quad(a, d, c, b, material);
+  }
+
+  // The six inner faces of the box [lo, hi], fronts facing inward.
+  void closedBoxInside(const float3& lo, const float3& hi, int material) {
+    const float x0 = lo[0], y0 = lo[1], z0 = lo[2], x1 = hi[0], y1 = hi[1], z1 = hi[2];
+    const float3 c = (lo + hi) * 0.5f;
+    quadFacing({x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1}, c, material);  // floor
+    quadFacing({x0, y1, z0}, {x0, y1, z1}, {x1, y1, z1}, {x1, y1, z0}, c, material);  // ceiling
+    quadFacing({x0, y0, z0}, {x0, y0, z1}, {x0, y1, z1}, {x0, y1, z0}, c, material);  // left
+    quadFacing({x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1}, c, material);  // right
+    quadFacing({x0, y0, z0}, {x0, y1, z0}, {x1, y1, z0}, {x1, y0, z0}, c, material);  // back
+    quadFacing({x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1}, c, material);  // front
+  }
+
+  Scene build() {
+    Scene s = scene_;
+    s.sourcePath = "<test scene>";
+    collectLights(s);
+    return s;
+  }
+
+ private:
+  Scene scene_;
+};
+
+}  // namespace fh::test

@@ -1,0 +1,289 @@
+// The path tracer against closed forms, each for every method, with tolerances from the
+// render's own variance (per-pixel sums of squares), and deterministic seeds:
+// - a closed box of albedo rho and emission Le: radiance Le / (1 - rho) everywhere
+//   (Russian roulette and the depth limit must not bias it);
+// - a diffuse plane under a one-sided rectangular emitter: Lambert's polygon formula;
+// - a plane under a constant environment: rho * L_env;
+// - pt, nee and mis agree on the Cornell box within their combined noise;
+// - no sample is ever NaN or infinite; the image is deterministic for a seed.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <nlohmann/json.hpp>
+
+#include "path_tracer.h"
+#include "scene_builder.h"
+#include "test_support.h"
+
+namespace fh {
+namespace {
+
+using test::SceneBuilder;
+
+// A z-score above this in a test's main comparison fails it: for a normal statistic,
+// about 1 in 15000 false failures per comparison.
+constexpr double kZ = 4.0;
+
+struct Rendered {
+  Film film;
+  RenderStats stats;
+};
+
+Rendered render(const Scene& scene, const Camera& camera, Method method, int size, int spp, unsigned seed = 1,
+                size_t wavefront = 0, std::array<float, 3> env = {0, 0, 0}) {
+  static DeviceContext dc(selectDevices(listDevices(), "").front());
+  const Bvh bvh = buildBvh(scene);
+  RenderSettings s;
+  s.width = s.height = size;
+  s.spp = spp;
+  s.method = method;
+  s.seed = seed;
+  s.wavefront = wavefront;
+  s.env = env;
+  PathTracer tracer(dc, scene, bvh, camera, s);
+  Rendered r{tracer.render(), tracer.stats()};
+  return r;
+}
+
+double luminanceMean(const Film& f, size_t p) {
+  double m = 0;
+  for (int c = 0; c < 3; ++c) m += f.sum[4 * p + size_t(c)];
+  return m / (3.0 * f.count(p));
+}
+
+// Variance of the per-pixel mean of the channel average, bounded by the channels' sum.
+double pixelVariance(const Film& f, size_t p) {
+  const auto v = f.varianceOfMean(p);
+  return (v[0] + v[1] + v[2]) / 3.0;
+}
+
+// Compares the render with `expected(p)` per pixel (NaN: skip the pixel): the image mean
+// by a z-test, and 4x4-pixel blocks by z-tests of which at most `blockShare` may fail at
+// |z| > 3.29 (0.1 % two-sided each for a normal mean). Blocks rather than pixels: at a
+// few hundred samples a pixel's mean is too skewed for a normal test (paths that find a
+// small light by chance, next-event samples next to an emitter's edge), and measured
+// per-pixel failure rates were 1-6 % on correct renders.
+void expectMatches(const Film& f, const std::function<double(size_t)>& expected, const std::string& what,
+                   double blockShare = 0.05) {
+  const int block = 4;
+  double diffSum = 0, varSum = 0;
+  size_t blocks = 0, outliers = 0;
+  for (int by = 0; by < f.height / block; ++by)
+    for (int bx = 0; bx < f.width / block; ++bx) {
+      double diff = 0, var = 0;
+      int n = 0;
+      for (int y = by * block; y < (by + 1) * block; ++y)
+        for (int x = bx * block; x < (bx + 1) * block; ++x) {
+          const size_t p = size_t(y) * size_t(f.width) + size_t(x);
+          const double e = expected(p);
+          if (std::isnan(e)) continue;
+          diff += luminanceMean(f, p) - e;
+          var += pixelVariance(f, p);
+          ++n;
+        }
+      if (n == 0) continue;
+      diffSum += diff;
+      varSum += var;
+      ++blocks;
+      if (std::fabs(diff / n) > 3.29 * std::sqrt(var) / n) ++outliers;
+    }
+  ASSERT_GT(blocks, 0u);
+  const double z = diffSum / std::sqrt(std::max(varSum, 1e-30));
+  EXPECT_LT(std::fabs(z), kZ) << what << ": image mean off by " << diffSum << " (z = " << z << ")";
+  EXPECT_LE(double(outliers), blockShare * double(blocks) + 1)
+      << what << ": " << outliers << " of " << blocks << " blocks outside 3.29 sigma";
+}
+
+void PrintTo(Method m, std::ostream* os) { *os << methodName(m); }
+
+class EveryMethod : public ::testing::TestWithParam<Method> {};
+
+std::string methodParamName(const ::testing::TestParamInfo<Method>& info) { return methodName(info.param); }
+
+INSTANTIATE_TEST_SUITE_P(PathTracer, EveryMethod, ::testing::Values(Method::PT, Method::NEE, Method::MIS),
+                         methodParamName);
+
+Camera insideCamera() {
+  Camera c;
+  c.eye = {0.1f, -0.2f, 0.3f};
+  c.target = {0.4f, 0.1f, -1.f};
+  c.up = {0, 1, 0};
+  c.fovYDeg = 70.f;
+  return c;
+}
+
+TEST_P(EveryMethod, ClosedFurnaceBoxIsLeOverOneMinusRho) {
+  for (const float rho : {0.5f, 0.8f}) {
+    SceneBuilder b;
+    const float le = 1.f;
+    b.closedBoxInside({-1, -1, -1}, {1, 1, 1}, b.material(rho, le));
+    const Scene scene = b.build();
+    const Rendered r = render(scene, insideCamera(), GetParam(), 16, 256);
+    EXPECT_EQ(r.stats.nonfinite, 0u);
+    EXPECT_EQ(r.stats.samples, 16u * 16u * 256u);
+    expectMatches(r.film, [&](size_t) { return le / (1.0 - rho); },
+                  std::string(methodName(GetParam())) + ", rho " + std::to_string(rho));
+  }
+}
+
+// Irradiance at x (normal n) from a uniformly emitting polygon of radiance le:
+// E = (le / 2) |sum_k Theta_k (n . Gamma_k)| (Lambert; the polygon wholly in front of x).
+double lambertIrradiance(const float3& x, const float3& n, const std::vector<float3>& polygon, double le) {
+  double sum = 0;
+  for (size_t k = 0; k < polygon.size(); ++k) {
+    const float3 a = normalize(polygon[k] - x), b = normalize(polygon[(k + 1) % polygon.size()] - x);
+    const double theta = std::acos(std::clamp(double(dot(a, b)), -1.0, 1.0));
+    sum += theta * dot(normalize(cross(a, b)), n);
+  }
+  return 0.5 * le * std::fabs(sum);
+}
+
+TEST_P(EveryMethod, PlaneUnderRectangularEmitterFollowsLambertsFormula) {
+  SceneBuilder b;
+  const float rho = 0.5f, le = 4.f, h = 1.f;
+  b.quad({-5, 0, -5}, {-5, 0, 5}, {5, 0, 5}, {5, 0, -5}, b.material(rho));  // faces +y
+  const std::vector<float3> light = {{-0.5f, h, -0.5f}, {0.5f, h, -0.5f}, {0.5f, h, 0.5f}, {-0.5f, h, 0.5f}};
+  b.quad(light[0], light[1], light[2], light[3], b.material(0.f, le));  // faces -y, toward the plane
+  const Scene scene = b.build();
+  Camera camera;
+  camera.eye = {0.f, 0.6f, 2.5f};  // below the emitter, which it sees from the front
+  camera.target = {0.f, 0.f, 0.f};
+  camera.fovYDeg = 60.f;
+  const int size = 24;
+  const Rendered r = render(scene, camera, GetParam(), size, 256);
+  EXPECT_EQ(r.stats.nonfinite, 0u);
+
+  // The exact pixel value: the box filter's average over the pixel, integrated on an 8x8
+  // grid; pixels whose footprint sees more than one surface (edges) are skipped.
+  const CameraFrame f = makeCameraFrame(camera, size, size);
+  auto radianceAlong = [&](const float3& d, int& surface) -> double {
+    const double org[3] = {camera.eye[0], camera.eye[1], camera.eye[2]}, dir[3] = {d[0], d[1], d[2]};
+    const test::BruteHit hit = test::bruteForceClosest(scene, org, dir);
+    surface = hit.triangle < 0 ? -1 : scene.triangleMaterial[size_t(hit.triangle)];
+    if (surface < 0) return 0.0;
+    if (surface == 1) return dot(d, {0, 1, 0}) > 0 ? le : 0.0;  // the emitter's front faces down
+    const float3 x = camera.eye + d * float(hit.t);
+    return rho / M_PI * lambertIrradiance(x, {0, 1, 0}, light, le);
+  };
+  std::vector<double> expected(size_t(size) * size);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      double sum = 0;
+      int first = -2;
+      bool mixed = false;
+      for (int j = 0; j < 8; ++j)
+        for (int i = 0; i < 8; ++i) {
+          int surface;
+          sum += radianceAlong(normalize(cameraRayDirection(f, x + (i + 0.5f) / 8, y + (j + 0.5f) / 8, size, size)),
+                               surface);
+          mixed |= first != -2 && surface != first;
+          first = surface;
+        }
+      expected[size_t(y * size + x)] = mixed ? NAN : sum / 64;
+    }
+  expectMatches(r.film, [&](size_t p) { return expected[p]; }, methodName(GetParam()));
+}
+
+TEST_P(EveryMethod, PlaneUnderConstantEnvironmentIsRhoTimesEnv) {
+  SceneBuilder b;
+  const float rho = 0.6f, env = 2.f;
+  b.quad({-50, 0, -50}, {-50, 0, 50}, {50, 0, 50}, {50, 0, -50}, b.material(rho));
+  const Scene scene = b.build();
+  Camera camera;
+  camera.eye = {0, 1, 0};
+  camera.target = {0.2f, 0, -1};
+  camera.fovYDeg = 40.f;  // sees only the plane
+  const Rendered r = render(scene, camera, GetParam(), 16, 256, 3, 0, {env, env, env});
+  expectMatches(r.film, [&](size_t) { return rho * env; }, methodName(GetParam()));
+}
+
+TEST(PathTracer, MethodsAgreeOnTheCornellBox) {
+  const Scene scene = loadDefaultScene();
+  const int size = 24, spp = 256;
+  const Rendered pt = render(scene, scene.camera, Method::PT, size, spp, 11);
+  const Rendered nee = render(scene, scene.camera, Method::NEE, size, spp, 12);
+  const Rendered mis = render(scene, scene.camera, Method::MIS, size, spp, 13);
+  for (const Rendered* r : {&pt, &nee, &mis}) EXPECT_EQ(r->stats.nonfinite, 0u);
+  // Each pair: the difference of two independent estimates has the sum of their variances.
+  // Compared over 4x4-pixel blocks (4096 samples each): pt's per-pixel means at 256 spp are
+  // too skewed (rare hits on the small light) for a per-pixel normal test.
+  const int block = 4;
+  auto blockStats = [&](const Film& f, int bx, int by, double& mean, double& var) {
+    mean = var = 0;
+    for (int y = by * block; y < (by + 1) * block; ++y)
+      for (int x = bx * block; x < (bx + 1) * block; ++x) {
+        const size_t p = size_t(y * size + x);
+        mean += luminanceMean(f, p) / (block * block);
+        var += pixelVariance(f, p) / double(block * block * block * block);
+      }
+  };
+  auto agree = [&](const Film& a, const Film& b, const std::string& what) {
+    double diff = 0, var = 0;
+    int outliers = 0, n = 0;
+    for (int by = 0; by < size / block; ++by)
+      for (int bx = 0; bx < size / block; ++bx) {
+        double ma, va, mb, vb;
+        blockStats(a, bx, by, ma, va);
+        blockStats(b, bx, by, mb, vb);
+        diff += ma - mb;
+        var += va + vb;
+        ++n;
+        if (std::fabs(ma - mb) > 3.29 * std::sqrt(va + vb)) ++outliers;
+      }
+    EXPECT_LT(std::fabs(diff / std::sqrt(var)), kZ) << what << ": mean difference " << diff / n;
+    EXPECT_LE(outliers, 2) << what << ": " << outliers << " of " << n << " blocks outside 3.29 sigma";
+  };
+  agree(pt.film, nee.film, "pt vs nee");
+  agree(pt.film, mis.film, "pt vs mis");
+  agree(nee.film, mis.film, "nee vs mis");
+  // mis should be no noisier than the better of the two on this scene.
+  double vPt = 0, vNee = 0, vMis = 0;
+  for (size_t p = 0; p < size_t(size) * size; ++p) {
+    vPt += pixelVariance(pt.film, p);
+    vNee += pixelVariance(nee.film, p);
+    vMis += pixelVariance(mis.film, p);
+  }
+  EXPECT_LT(vMis, 1.5 * std::min(vPt, vNee));
+}
+
+TEST(PathTracer, DeterministicForASeedWhateverTheWavefront) {
+  const Scene scene = loadDefaultScene();
+  const Rendered a = render(scene, scene.camera, Method::MIS, 16, 8, 5, 256);
+  const Rendered b = render(scene, scene.camera, Method::MIS, 16, 8, 5, 1024);
+  const Rendered c = render(scene, scene.camera, Method::MIS, 16, 8, 6, 256);
+  EXPECT_EQ(a.film.sum, b.film.sum);
+  EXPECT_EQ(a.film.sumSq, b.film.sumSq);
+  EXPECT_NE(a.film.sum, c.film.sum);
+}
+
+TEST(PathTracer, NoNonFiniteSamplesOnTheSharedDiffuseScenes) {
+  if (!test::haveSharedScenes()) GTEST_SKIP() << "../shared/scenes not present";
+  for (const char* path : {"cornell-box/CornellBox-Original.obj", "cornell-box/CornellBox-Empty-CO.obj",
+                           "cornell-box/CornellBox-Empty-White.obj", "cornell-box/CornellBox-Empty-Squashed.obj",
+                           "bunny/CornellBox-Bunny.obj"}) {
+    const Scene scene = loadScene(test::sharedScene(path));
+    for (Method m : {Method::PT, Method::NEE, Method::MIS}) {
+      const Rendered r = render(scene, scene.camera, m, 16, 4);
+      EXPECT_EQ(r.stats.nonfinite, 0u) << path << " " << methodName(m);
+      for (float v : r.film.image().rgb) ASSERT_TRUE(std::isfinite(v)) << path;
+    }
+  }
+}
+
+TEST(PathTracer, StatsCountRaysAndSamples) {
+  const Scene scene = loadDefaultScene();
+  const Rendered r = render(scene, scene.camera, Method::MIS, 16, 4);
+  EXPECT_EQ(r.stats.samples, 16u * 16u * 4u);
+  EXPECT_EQ(r.stats.cameraRays, r.stats.samples);
+  EXPECT_GT(r.stats.bounceRays, 0u);
+  EXPECT_GT(r.stats.shadowRays, 0u);
+  EXPECT_GT(r.stats.kernelSeconds.at("shade"), 0.0);
+  const auto json = nlohmann::json::parse(statsJson(r.stats, RenderSettings{}));
+  for (const char* key : {"samples", "seconds", "samples_per_second", "nonfinite_samples", "devices"})
+    EXPECT_TRUE(json.contains(key)) << key;
+  EXPECT_EQ(json["devices"][0]["samples"], r.stats.samples);
+}
+
+}  // namespace
+}  // namespace fh
