@@ -169,11 +169,13 @@ PathTracer::PathTracer(DeviceContext& dc, const Scene& scene, const Bvh& bvh, co
   const cl::Program program =
       buildProgram(dc.context, dc.info.device,
                    {"generate.cl", "intersect.cl", "shade.cl", "shadow_connect.cl", "accumulate.cl"}, options);
+  plan_ = createKernel(program, "plan_iteration");
   generate_ = createKernel(program, "generate_paths");
   intersect_ = createKernel(program, "intersect_paths");
   shade_ = createKernel(program, "shade");
   shadowConnect_ = createKernel(program, "shadow_connect");
   accumulatePaths_ = createKernel(program, "accumulate_paths");
+  finish_ = createKernel(program, "finish_iteration");
   accumulatePass_ = createKernel(program, "accumulate_pass");
 
   auto buffer = [&](size_t bytes, const char* what, const void* host = nullptr) {
@@ -209,60 +211,73 @@ void PathTracer::timeKernel(const char* name, const cl::Event& event) {
   stats_.kernelSeconds[name] += double(end - start) * 1e-9;
 }
 
-// One wavefront iteration over every path in flight: the five stages in order.
-void PathTracer::runIteration(unsigned generateCount, unsigned firstSample, unsigned freeTop, unsigned rayCount,
-                              int current) {
-  const unsigned capacity = rayCount + generateCount;  // rays after generate
-  const int next = 1 - current;
-  const unsigned nextCounter = current == 0 ? FH_COUNT_RAYS_B : FH_COUNT_RAYS_A;
+// One wavefront iteration over every path in flight: the five stages in order, framed
+// by the device's bookkeeping. Each stage is launched over the whole wavefront and reads
+// its queue's length on the device, so nothing here waits for the device.
+void PathTracer::enqueueIteration(int current) {
+  const cl_uint rays = current == 0 ? FH_COUNT_RAYS_A : FH_COUNT_RAYS_B;
+  const cl_uint nextRays = current == 0 ? FH_COUNT_RAYS_B : FH_COUNT_RAYS_A;
+  const cl::Buffer& queue = rayQueue_[current];
+  const cl::Buffer& nextQueue = rayQueue_[1 - current];
   auto run = [&](cl::Kernel& k, size_t n, const char* name) {
-    if (n == 0) return;
     cl::Event e;
     launch(dc_, k, n, name, &e);
     events_.emplace_back(name, e);
   };
 
-  setArgs(generate_, params_, firstSample, generateCount, freeTop, freeList_, rayQueue_[current], rayCount,
-          filterTable_);
-  setPathArgs(generate_, 8, pathState_);
-  run(generate_, generateCount, "generate");
+  setArgs(plan_, counters_, rays, nextRays);
+  run(plan_, 1, "bookkeeping");
 
-  setArgs(intersect_, scene_.caster.nodes(), scene_.caster.blocks(), rayQueue_[current], capacity, pathState_[0],
+  setArgs(generate_, params_, counters_, freeList_, queue, filterTable_);
+  setPathArgs(generate_, 5, pathState_);
+  run(generate_, wavefront_, "generate");
+
+  setArgs(intersect_, scene_.caster.nodes(), scene_.caster.blocks(), queue, counters_, rays, pathState_[0],
           pathState_[1], pathState_[2]);
-  run(intersect_, capacity, "intersect");
+  run(intersect_, wavefront_, "intersect");
 
-  setArgs(shade_, params_, rayQueue_[current], capacity, rayQueue_[next], finishedQueue_, counters_, nextCounter,
-          scene_.caster.triangles(), scene_.triangleMaterial, scene_.materials, scene_.lightPdfArea);
+  setArgs(shade_, params_, queue, nextQueue, finishedQueue_, counters_, rays, nextRays, scene_.caster.triangles(),
+          scene_.triangleMaterial, scene_.materials, scene_.lightPdfArea);
   setPathArgs(shade_, 11, pathState_);
   setPathArgs(shade_, cl_uint(11 + pathState_.size()), shadowRequests_);
-  run(shade_, capacity, "shade");
+  run(shade_, wavefront_, "shade");
 
   if (settings_.method != Method::PT && scene_.lightCount > 0) {
-    setArgs(shadowConnect_, params_, capacity, counters_, scene_.caster.nodes(), scene_.caster.blocks(),
+    setArgs(shadowConnect_, params_, counters_, scene_.caster.nodes(), scene_.caster.blocks(),
             scene_.caster.triangles(), scene_.triangleMaterial, scene_.materials, scene_.lightCdf,
             scene_.lightTriangle, scene_.lightPdfArea);
-    setPathArgs(shadowConnect_, 11, pathState_);
-    setPathArgs(shadowConnect_, cl_uint(11 + pathState_.size()), shadowRequests_);
-    run(shadowConnect_, capacity, "shadow_connect");
+    setPathArgs(shadowConnect_, 10, pathState_);
+    setPathArgs(shadowConnect_, cl_uint(10 + pathState_.size()), shadowRequests_);
+    run(shadowConnect_, wavefront_, "shadow_connect");
   }
 
-  setArgs(accumulatePaths_, finishedQueue_, capacity, counters_, freeList_, freeTop - generateCount, pixels_,
-          passBuffer_);
-  setPathArgs(accumulatePaths_, 7, pathState_);
-  run(accumulatePaths_, capacity, "accumulate");
+  setArgs(accumulatePaths_, finishedQueue_, counters_, freeList_, pixels_, passBuffer_);
+  setPathArgs(accumulatePaths_, 5, pathState_);
+  run(accumulatePaths_, wavefront_, "accumulate");
+
+  setArgs(finish_, counters_, rays, nextRays);
+  run(finish_, 1, "bookkeeping");
+}
+
+void PathTracer::collectKernelTimes() {
+  for (const auto& [name, event] : events_) timeKernel(name, event);
+  events_.clear();
 }
 
 // Adds every completed pass to the film, in pass order.
-void PathTracer::foldCompletedPasses(uint32_t* counters, uint64_t& passesDone, uint64_t samplesStarted) {
+void PathTracer::foldCompletedPasses(uint32_t* counters, uint64_t& passesDone) {
+  const uint64_t started = counters[FH_COUNT_NEXT_SAMPLE];
   for (;;) {
     const unsigned slot = unsigned(passesDone % passSlots_);
-    if (counters[FH_COUNT_PASS_DONE + slot] != pixels_ || passesDone * pixels_ >= samplesStarted) return;
+    if (counters[FH_COUNT_PASS_DONE + slot] != pixels_ || passesDone * pixels_ >= started) return;
     setArgs(accumulatePass_, passBuffer_, unsigned(passesDone), pixels_, filmSum_, filmSumSq_);
     cl::Event e;
     launch(dc_, accumulatePass_, pixels_, "accumulate_pass", &e);
-    const uint32_t zero = 0;
-    FH_CL(dc_.queue.enqueueWriteBuffer(counters_, CL_TRUE, (FH_COUNT_PASS_DONE + slot) * 4, 4, &zero));
-    timeKernel("accumulate", e);
+    // The counter may have grown on the device since it was read only if the next pass
+    // using this slot had started, which the sample limit rules out: resetting is safe.
+    static const uint32_t zero = 0;
+    FH_CL(dc_.queue.enqueueWriteBuffer(counters_, CL_FALSE, (FH_COUNT_PASS_DONE + slot) * 4, 4, &zero));
+    events_.emplace_back("accumulate", e);
     counters[FH_COUNT_PASS_DONE + slot] = 0;
     ++passesDone;
   }
@@ -272,49 +287,46 @@ Film PathTracer::render() {
   const auto start = Clock::now();
   const uint64_t pixels = pixels_;
   const uint64_t maxSamples = uint64_t(std::max(1, settings_.spp)) * pixels;
+  if (maxSamples >= (uint64_t(1) << 32))
+    throw Error("--spp " + std::to_string(settings_.spp) + " at " + std::to_string(settings_.width) + "x" +
+                std::to_string(settings_.height) + " is more than 2^32 samples in one render; render fewer");
   uint64_t limit = maxSamples;  // shrinks to the end of the running pass when time is up
-  uint64_t nextSample = 0, passesDone = 0, rayQueueSum = 0;
-  unsigned freeCount = unsigned(wavefront_), rayCount = 0;
-  int current = 0;
+  uint64_t passesDone = 0;
   Progress progress(settings_.progress);
   stats_ = RenderStats{};
   stats_.device = dc_.info.name;
   stats_.wavefront = wavefront_;
-  uint32_t counters[FH_COUNT_TOTAL] = {};
 
+  uint32_t counters[FH_COUNT_TOTAL] = {};
+  counters[FH_COUNT_FREE] = unsigned(wavefront_);
+  // Pass p + passSlots reuses pass p's buffer: it may start once pass p is folded in.
+  auto sampleLimit = [&] { return uint32_t(std::min(limit, (passesDone + passSlots_) * pixels)); };
+  counters[FH_COUNT_SAMPLE_LIMIT] = sampleLimit();
+  FH_CL(dc_.queue.enqueueWriteBuffer(counters_, CL_TRUE, 0, sizeof counters, counters));
+
+  // Iterations are queued in batches; the host reads the counters once per batch.
+  const int batch = 8;
+  int current = 0;
   while (passesDone * pixels < limit) {
+    for (int k = 0; k < batch; ++k, current = 1 - current) enqueueIteration(current);
+    FH_CL(dc_.queue.enqueueReadBuffer(counters_, CL_TRUE, 0, sizeof counters, counters));
+    collectKernelTimes();
+    foldCompletedPasses(counters, passesDone);
+
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     if (settings_.seconds > 0.0 && elapsed >= settings_.seconds && limit == maxSamples)
-      limit = std::max<uint64_t>(1, (nextSample + pixels - 1) / pixels) * pixels;
-    // Pass p + passSlots reuses pass p's buffer: it may start once pass p is folded in.
-    const uint64_t allowed = std::min(limit, (passesDone + passSlots_) * pixels);
-    const unsigned generate = unsigned(std::min<uint64_t>(freeCount, allowed - std::min(allowed, nextSample)));
-
-    // Queue lengths for this iteration: generate appends after the rays already queued.
-    counters[current == 0 ? FH_COUNT_RAYS_A : FH_COUNT_RAYS_B] = rayCount + generate;
-    counters[current == 0 ? FH_COUNT_RAYS_B : FH_COUNT_RAYS_A] = 0;
-    counters[FH_COUNT_SHADOW] = counters[FH_COUNT_FINISHED] = 0;
-    FH_CL(dc_.queue.enqueueWriteBuffer(counters_, CL_FALSE, 0, 4 * 4, counters));
-    if (generate + rayCount > 0) runIteration(generate, unsigned(nextSample), freeCount, rayCount, current);
-    nextSample += generate;
-    stats_.cameraRays += generate;
-    rayQueueSum += generate + rayCount;
-    ++stats_.iterations;
-
-    FH_CL(dc_.queue.enqueueReadBuffer(counters_, CL_TRUE, 0, sizeof counters, counters));
-    for (const auto& [name, event] : events_) timeKernel(name, event);
-    events_.clear();
-    current = 1 - current;
-    rayCount = counters[current == 0 ? FH_COUNT_RAYS_A : FH_COUNT_RAYS_B];
-    freeCount = freeCount - generate + counters[FH_COUNT_FINISHED];
-    stats_.bounceRays += rayCount;
-    stats_.shadowRays += counters[FH_COUNT_SHADOW];
-
-    foldCompletedPasses(counters, passesDone, nextSample);
-    progress.update(passesDone * pixels, settings_.seconds > 0.0 ? 0 : maxSamples,
-                    std::chrono::duration<double>(Clock::now() - start).count(),
+      limit = std::max<uint64_t>(1, (uint64_t(counters[FH_COUNT_NEXT_SAMPLE]) + pixels - 1) / pixels) * pixels;
+    const uint32_t newLimit = sampleLimit();
+    if (newLimit != counters[FH_COUNT_SAMPLE_LIMIT]) {
+      counters[FH_COUNT_SAMPLE_LIMIT] = newLimit;
+      FH_CL(dc_.queue.enqueueWriteBuffer(counters_, CL_FALSE, FH_COUNT_SAMPLE_LIMIT * 4, 4,
+                                         &counters[FH_COUNT_SAMPLE_LIMIT]));
+    }
+    progress.update(passesDone * pixels, settings_.seconds > 0.0 ? 0 : maxSamples, elapsed,
                     settings_.seconds > 0.0 ? std::min(1.0, elapsed / settings_.seconds) : 0.0);
   }
+  FH_CL(dc_.queue.finish());
+  collectKernelTimes();
 
   Film film;
   film.width = settings_.width;
@@ -323,10 +335,16 @@ Film PathTracer::render() {
   film.sumSq.resize(size_t(pixels) * 4);
   FH_CL(dc_.queue.enqueueReadBuffer(filmSum_, CL_TRUE, 0, film.sum.size() * 4, film.sum.data()));
   FH_CL(dc_.queue.enqueueReadBuffer(filmSumSq_, CL_TRUE, 0, film.sumSq.size() * 4, film.sumSq.data()));
+  auto total64 = [&](int index) { return uint64_t(counters[index]) | uint64_t(counters[index + 1]) << 32; };
   stats_.samples = passesDone * pixels;
+  stats_.cameraRays = counters[FH_COUNT_NEXT_SAMPLE];
+  stats_.bounceRays = total64(FH_COUNT_BOUNCE_RAYS);
+  stats_.shadowRays = total64(FH_COUNT_SHADOW_RAYS);
+  stats_.iterations = counters[FH_COUNT_ITERATIONS];
   stats_.nonfinite = counters[FH_COUNT_NONFINITE];
   stats_.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  stats_.meanQueueOccupancy = stats_.iterations ? double(rayQueueSum) / double(stats_.iterations * wavefront_) : 0.0;
+  stats_.meanQueueOccupancy =
+      stats_.iterations ? double(total64(FH_COUNT_QUEUED_RAYS)) / double(stats_.iterations * wavefront_) : 0.0;
   progress.finish(stats_.samples, stats_.seconds);
   return film;
 }

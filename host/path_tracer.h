@@ -76,8 +76,9 @@ class PathTracer {
 
  private:
   struct Launch;
-  void runIteration(unsigned generateCount, unsigned firstSample, unsigned freeTop, unsigned rayCount, int current);
-  void foldCompletedPasses(uint32_t* counters, uint64_t& passesDone, uint64_t samplesStarted);
+  void enqueueIteration(int current);
+  void collectKernelTimes();
+  void foldCompletedPasses(uint32_t* counters, uint64_t& passesDone);
   void timeKernel(const char* name, const cl::Event& event);
 
   DeviceContext& dc_;
@@ -89,7 +90,7 @@ class PathTracer {
   unsigned passSlots_;  // passes in flight at most
   std::vector<cl::Buffer> pathState_, shadowRequests_;
   cl::Buffer rayQueue_[2], finishedQueue_, freeList_, counters_, passBuffer_, filmSum_, filmSumSq_, filterTable_;
-  cl::Kernel generate_, intersect_, shade_, shadowConnect_, accumulatePaths_, accumulatePass_;
+  cl::Kernel plan_, generate_, intersect_, shade_, shadowConnect_, accumulatePaths_, finish_, accumulatePass_;
   std::vector<std::pair<const char*, cl::Event>> events_;
   RenderStats stats_;
 };

@@ -6,14 +6,13 @@
 // longest paths finish.
 #include "path_state.h"
 
-__kernel void accumulate_paths(__global const uint* finished_queue, uint capacity, volatile __global uint* counters,
-                               __global uint* free_list, uint free_base, uint pixel_count,
-                               __global float4* pass_buffer FH_PATH_PARAMS) {
+__kernel void accumulate_paths(__global const uint* finished_queue, volatile __global uint* counters,
+                               __global uint* free_list, uint pixel_count, __global float4* pass_buffer FH_PATH_PARAMS) {
   volatile __local uint finished_in_slot[FH_PASS_SLOTS];
   const uint i = get_global_id(0), lid = get_local_id(0);
   if (lid < FH_PASS_SLOTS) finished_in_slot[lid] = 0;
   barrier(CLK_LOCAL_MEM_FENCE);
-  if (i < capacity && i < counters[FH_COUNT_FINISHED]) {
+  if (i < counters[FH_COUNT_FINISHED]) {
     const uint p = finished_queue[i];
     const uint k = sample_id[p];
     const uint pixel = k % pixel_count, slot = (k / pixel_count) % FH_PASS_SLOTS;
@@ -25,11 +24,28 @@ __kernel void accumulate_paths(__global const uint* finished_queue, uint capacit
     }
     pass_buffer[slot * pixel_count + pixel] = (float4)(value, 1.0f);
     atomic_inc(&finished_in_slot[slot]);
-    free_list[free_base + i] = p;
+    free_list[counters[FH_COUNT_FREE] + i] = p;
   }
   // One global atomic per pass slot and work-group (see group_append).
   barrier(CLK_LOCAL_MEM_FENCE);
   if (lid < FH_PASS_SLOTS && finished_in_slot[lid]) atomic_add(&counters[FH_COUNT_PASS_DONE + lid], finished_in_slot[lid]);
+}
+
+// Closes an iteration's books (a single work-item): the freed slots join the free list,
+// and the ray totals grow.
+inline void add_64(volatile __global uint* pair, uint value) {
+  const uint low = pair[0] + value;
+  pair[1] += low < value;  // carry
+  pair[0] = low;
+}
+
+__kernel void finish_iteration(volatile __global uint* counters, uint ray_counter, uint next_counter) {
+  if (get_global_id(0) != 0) return;
+  counters[FH_COUNT_FREE] += counters[FH_COUNT_FINISHED];
+  add_64(counters + FH_COUNT_BOUNCE_RAYS, counters[next_counter]);
+  add_64(counters + FH_COUNT_SHADOW_RAYS, counters[FH_COUNT_SHADOW]);
+  add_64(counters + FH_COUNT_QUEUED_RAYS, counters[ray_counter]);
+  counters[FH_COUNT_ITERATIONS] += 1;
 }
 
 // Adds pass `pass`'s buffer to the film: per pixel the sum of samples (w: count) and the

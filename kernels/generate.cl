@@ -6,17 +6,34 @@
 #include "path_state.h"
 #include "rng.h"
 
-// Starts samples first_sample .. first_sample + count - 1 in the slots on top of the
-// free list (free_top entries) and appends them to the ray queue from position
-// queue_base (the host knows both counts, so no atomics are needed). Sample k is pixel
-// k % pixel_count of pass k / pixel_count.
-__kernel void generate_paths(RenderParams params, uint first_sample, uint count, uint free_top,
-                             __global const uint* free_list, __global uint* ray_queue, uint queue_base,
-                             __global const float* filter_table FH_PATH_PARAMS) {
+// Plans one iteration (a single work-item): how many new samples start (as many as free
+// slots, up to the limit the host set), where they take their slots and queue places,
+// and resets this iteration's queues.
+__kernel void plan_iteration(volatile __global uint* counters, uint ray_counter, uint next_counter) {
+  if (get_global_id(0) != 0) return;
+  const uint free_slots = counters[FH_COUNT_FREE], next = counters[FH_COUNT_NEXT_SAMPLE];
+  const uint limit = counters[FH_COUNT_SAMPLE_LIMIT];
+  const uint count = min(free_slots, limit - min(limit, next));
+  counters[FH_COUNT_GEN_COUNT] = count;
+  counters[FH_COUNT_GEN_FIRST] = next;
+  counters[FH_COUNT_GEN_FREE_TOP] = free_slots;
+  counters[FH_COUNT_GEN_QUEUE_BASE] = counters[ray_counter];
+  counters[FH_COUNT_FREE] = free_slots - count;
+  counters[FH_COUNT_NEXT_SAMPLE] = next + count;
+  counters[ray_counter] += count;
+  counters[next_counter] = 0;
+  counters[FH_COUNT_SHADOW] = 0;
+  counters[FH_COUNT_FINISHED] = 0;
+}
+
+// Starts the planned samples in the slots on top of the free list and appends them to
+// the ray queue. Sample k is pixel k % pixel_count of pass k / pixel_count.
+__kernel void generate_paths(RenderParams params, __global const uint* counters, __global const uint* free_list,
+                             __global uint* ray_queue, __global const float* filter_table FH_PATH_PARAMS) {
   const uint i = get_global_id(0);
-  if (i >= count) return;
-  const uint slot = free_list[free_top - 1 - i];
-  const uint k = first_sample + i;
+  if (i >= counters[FH_COUNT_GEN_COUNT]) return;
+  const uint slot = free_list[counters[FH_COUNT_GEN_FREE_TOP] - 1 - i];
+  const uint k = counters[FH_COUNT_GEN_FIRST] + i;
   const uint pixel = k % params.pixel_count, pass = k / params.pixel_count;
   const float2 u = pixel_sample_2d(params.seed, pixel, pass);
   const float px = (float)(pixel % (uint)params.camera.width) + 0.5f +
@@ -29,7 +46,7 @@ __kernel void generate_paths(RenderParams params, uint first_sample, uint count,
   radiance[slot] = (float4)(0.0f);
   sample_id[slot] = k;
   depth[slot] = 0;
-  ray_queue[queue_base + i] = slot;
+  ray_queue[counters[FH_COUNT_GEN_QUEUE_BASE] + i] = slot;
 }
 
 __kernel void generate_camera_rays(CameraParams cam, uint seed, uint sample_index, uint first_pixel,

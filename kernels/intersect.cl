@@ -24,12 +24,13 @@ __kernel void intersect_any(__global const Bvh8Node* nodes, __global const Trian
   occluded[i] = trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w, true).triangle >= 0;
 }
 
-// Closest hit for the paths in a ray queue: reads ray_org/ray_dir, writes hit.
+// Closest hit for the paths in a ray queue (its length is counters[ray_counter]): reads
+// ray_org/ray_dir, writes hit.
 __kernel void intersect_paths(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
-                              __global const uint* ray_queue, uint count, __global const float4* ray_org,
-                              __global const float4* ray_dir, __global float4* hit) {
+                              __global const uint* ray_queue, __global const uint* counters, uint ray_counter,
+                              __global const float4* ray_org, __global const float4* ray_dir, __global float4* hit) {
   const uint i = get_global_id(0);
-  if (i >= count) return;
+  if (i >= counters[ray_counter]) return;
   const uint p = ray_queue[i];
   const float4 o = ray_org[p], d = ray_dir[p];
   const TraceHit h = trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w, false);

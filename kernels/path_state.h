@@ -31,17 +31,30 @@
 #define FH_SHADOW_PARAMS FH_SHADOW_FIELDS(FH_PATH_PARAM)
 #endif
 
-// Device-side counters, one uint each, in one buffer.
-#define FH_COUNT_RAYS_A 0       // ray queue A length
-#define FH_COUNT_RAYS_B 1       // ray queue B length
-#define FH_COUNT_SHADOW 2       // light-sample requests this iteration
-#define FH_COUNT_FINISHED 3     // paths finished this iteration
-#define FH_COUNT_NONFINITE 4    // samples whose radiance was NaN or infinite (dropped)
-#define FH_MAX_PASS_SLOTS 8     // passes in flight at most (the host picks FH_PASS_SLOTS <= this)
+// Device-side counters, one uint each, in one buffer. The device keeps its own books
+// (plan_iteration and finish_iteration), so the host can queue many iterations without
+// waiting for any: it reads the counters back only now and then.
+#define FH_COUNT_RAYS_A 0         // ray queue A length
+#define FH_COUNT_RAYS_B 1         // ray queue B length
+#define FH_COUNT_SHADOW 2         // light-sample requests this iteration
+#define FH_COUNT_FINISHED 3       // paths finished this iteration
+#define FH_COUNT_NONFINITE 4      // samples whose radiance was NaN or infinite (dropped)
+#define FH_COUNT_FREE 5           // free path slots: the free list's length
+#define FH_COUNT_NEXT_SAMPLE 6    // samples started so far
+#define FH_COUNT_SAMPLE_LIMIT 7   // samples that may start (the host moves it)
+#define FH_COUNT_GEN_COUNT 8      // this iteration's new samples
+#define FH_COUNT_GEN_FIRST 9      // ... the first one's index
+#define FH_COUNT_GEN_FREE_TOP 10  // ... the free list's length before they took their slots
+#define FH_COUNT_GEN_QUEUE_BASE 11 // ... where they go in the ray queue
+#define FH_COUNT_BOUNCE_RAYS 12   // 64-bit totals as (low, high) pairs: bounce rays,
+#define FH_COUNT_SHADOW_RAYS 14   // shadow rays,
+#define FH_COUNT_QUEUED_RAYS 16   // and rays queued per iteration (for occupancy)
+#define FH_COUNT_ITERATIONS 18    // iterations run
+#define FH_MAX_PASS_SLOTS 8       // passes in flight at most (the host picks FH_PASS_SLOTS <= this)
 #ifndef FH_PASS_SLOTS
 #define FH_PASS_SLOTS FH_MAX_PASS_SLOTS  // pass p uses pass-buffer slot p % FH_PASS_SLOTS
 #endif
-#define FH_COUNT_PASS_DONE 5    // one counter per slot: paths finished in the pass it holds
+#define FH_COUNT_PASS_DONE 19     // one counter per slot: paths finished in the pass it holds
 #define FH_COUNT_TOTAL (FH_COUNT_PASS_DONE + FH_MAX_PASS_SLOTS)
 
 #ifdef __OPENCL_VERSION__

@@ -32,13 +32,14 @@ FH_INLINE float emission_weight(uint depth, float bsdf_pdf, float light_pdf_area
 #endif
 }
 
-__kernel void shade(RenderParams params, __global const uint* ray_queue, uint count, __global uint* next_queue,
-                    __global uint* finished_queue, volatile __global uint* counters, uint next_counter,
+__kernel void shade(RenderParams params, __global const uint* ray_queue, __global uint* next_queue,
+                    __global uint* finished_queue, volatile __global uint* counters, uint ray_counter,
+                    uint next_counter,
                     __global const float4* triangles, __global const int* triangle_material,
                     __global const GpuMaterial* materials, __global const float* light_pdf_area
                         FH_PATH_PARAMS FH_SHADOW_PARAMS) {
   volatile __local uint scratch[2];
-  const uint i = get_global_id(0);
+  const uint i = get_global_id(0), count = counters[ray_counter];
   bool continues = false, light_sample = false, finishes = false;
   uint p = 0;
   // What a light-sample request needs, kept until its queue position is known.

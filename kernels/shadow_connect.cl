@@ -15,14 +15,14 @@
 #define FH_DIM_LIGHT_U1 4
 #define FH_DIM_LIGHT_U2 5
 
-__kernel void shadow_connect(RenderParams params, uint capacity, volatile __global uint* counters,
+__kernel void shadow_connect(RenderParams params, volatile __global uint* counters,
                              __global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
                              __global const float4* triangles, __global const int* triangle_material,
                              __global const GpuMaterial* materials, __global const float* light_cdf,
                              __global const int* light_triangle, __global const float* light_pdf_area
                                  FH_PATH_PARAMS FH_SHADOW_PARAMS) {
   const uint i = get_global_id(0);
-  if (i >= capacity || i >= counters[FH_COUNT_SHADOW]) return;
+  if (i >= counters[FH_COUNT_SHADOW]) return;
   const uint p = shadow_path[i];
   const float4 position = shadow_position[i], normal = shadow_normal[i];
   SurfacePoint s;

@@ -17,6 +17,9 @@
 #include "test_support.h"
 
 namespace fh {
+
+void PrintTo(Method m, std::ostream* os) { *os << methodName(m); }
+
 namespace {
 
 using test::SceneBuilder;
@@ -94,8 +97,6 @@ void expectMatches(const Film& f, const std::function<double(size_t)>& expected,
   EXPECT_LE(double(outliers), blockShare * double(blocks) + 1)
       << what << ": " << outliers << " of " << blocks << " blocks outside 3.29 sigma";
 }
-
-void PrintTo(Method m, std::ostream* os) { *os << methodName(m); }
 
 class EveryMethod : public ::testing::TestWithParam<Method> {};
 
