@@ -1,0 +1,87 @@
+// The render command as a user runs it: flags, errors, the --stats file, time budgets.
+#include <gtest/gtest.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "image_io.h"
+#include "test_support.h"
+
+namespace fh {
+namespace {
+
+TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
+  const std::string dir = test::tempDir("cli");
+  const std::pair<const char*, const char*> cases[] = {
+      {"--method foo", "--method 'foo': unknown method (use pt, nee or mis)"},
+      {"--filter tent", "--filter 'tent': unknown filter"},
+      {"--env 1,1,x", "--env '1,1,x': 'x' is not a number"},
+      {"--aov shiny", "--aov 'shiny': unknown output"},
+      {"--eye 0,1", "--eye '0,1': expected three comma-separated numbers"},
+      {"--width 0", "--width/--height must be positive"},
+      {"--max-depth 0", "--max-depth must be at least 1"},
+      {"--camera /nonexistent/cam.json", "cannot open camera file"},
+      {"/nonexistent/scene.obj", "/nonexistent/scene.obj: OBJ file not found"},
+  };
+  for (const auto& [flags, message] : cases) {
+    const auto r = test::runFredholm(std::string("render ") + flags + " -o " + dir + "/x.png");
+    EXPECT_EQ(r.exitCode, 1) << flags << ": " << r.output;
+    EXPECT_NE(r.output.find(message), std::string::npos) << flags << ": " << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << flags << ": " << r.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.png"));
+}
+
+TEST(RenderCli, StatsAndExrMetadata) {
+  const std::string dir = test::tempDir("cli");
+  const auto r = test::runFredholm("render --width 16 --height 12 --spp 3 --method nee --seed 7 -o " + dir +
+                                   "/a.exr --stats " + dir + "/s.json");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  std::ifstream in(dir + "/s.json");
+  const auto stats = nlohmann::json::parse(in);
+  EXPECT_EQ(stats["samples"], 16 * 12 * 3);
+  EXPECT_EQ(stats["nonfinite_samples"], 0);
+  EXPECT_GT(stats["samples_per_second"].get<double>(), 0.0);
+  EXPECT_EQ(stats["devices"].size(), 1u);
+  EXPECT_EQ(stats["method"], "nee");
+  for (const char* kernel : {"generate", "intersect", "shade", "shadow_connect", "accumulate"})
+    EXPECT_TRUE(stats["kernels"].contains(kernel)) << kernel;
+  auto img = OIIO::ImageInput::open(dir + "/a.exr");
+  ASSERT_TRUE(img);
+  EXPECT_EQ(img->spec().get_string_attribute("fredholm:method"), "nee");
+  EXPECT_EQ(img->spec().get_string_attribute("fredholm:seed"), "7");
+  EXPECT_EQ(img->spec().width, 16);
+  EXPECT_EQ(img->spec().height, 12);
+  // An existing --stats file is kept without --force.
+  const auto again = test::runFredholm("render --width 8 --height 8 --spp 1 -o " + dir + "/b.exr --stats " + dir +
+                                       "/s.json");
+  EXPECT_EQ(again.exitCode, 1);
+  EXPECT_NE(again.output.find("--stats '" + dir + "/s.json': file exists"), std::string::npos) << again.output;
+}
+
+TEST(RenderCli, TimeBudgetEndsOnWholePasses) {
+  const std::string dir = test::tempDir("cli");
+  const auto r = test::runFredholm("render --width 32 --height 32 --time 1 -o " + dir + "/t.exr --stats " + dir +
+                                   "/s.json");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  std::ifstream in(dir + "/s.json");
+  const auto stats = nlohmann::json::parse(in);
+  const uint64_t samples = stats["samples"];
+  EXPECT_GT(samples, 0u);
+  EXPECT_EQ(samples % (32 * 32), 0u);           // every pixel has the same sample count
+  EXPECT_LT(stats["seconds"].get<double>(), 10.0);  // the budget, plus the pass running then
+}
+
+TEST(RenderCli, ProgressLinesWhenNotATerminal) {
+  const std::string dir = test::tempDir("cli");
+  const auto r = test::runFredholm("render --width 16 --height 16 --spp 8 -o " + dir + "/p.png");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("fredholm: 100%"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("Msamples/s"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find('\r'), std::string::npos);  // no redrawn bar in a log
+}
+
+}  // namespace
+}  // namespace fh
