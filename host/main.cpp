@@ -93,7 +93,11 @@ int runRender(RenderOptions o) {
   if (o.maxDepth < 1) throw Error("--max-depth must be at least 1");
   if (o.wavefront != 0 && o.wavefront < kLocalSize) throw Error("--wavefront must be at least 64");
   // With --time and no --spp, the time decides; otherwise 64 spp by default.
-  const int spp = o.spp > 0 ? o.spp : (o.seconds > 0 ? (1 << 20) : (debugView ? 4 : 64));
+  // (A render numbers its samples in 32 bits: a time budget may take at most that many.)
+  const uint64_t pixels = uint64_t(o.width) * uint64_t(o.height);
+  const int spp = o.spp > 0 ? o.spp
+                            : (o.seconds > 0 ? int(std::min<uint64_t>(1 << 20, 0xFFFFFFFFull / pixels))
+                                             : (debugView ? 4 : 64));
   // An explicit -o is never overwritten without --force; the default name steps aside.
   if (o.output.empty()) o.output = firstFreeName("fredholm.png");
   checkOutputPath(o.output, o.force);

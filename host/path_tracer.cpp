@@ -198,6 +198,13 @@ PathTracer::PathTracer(DeviceContext& dc, const Scene& scene, const Bvh& bvh, co
   filmSumSq_ = buffer(size_t(pixels_) * 16, "film squares");
   filterTable_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, table.size() * 4, "filter table",
                                 table.data());
+  // Every pass this device may render: at most spp of them (a time budget stops earlier).
+  const uint64_t maxPasses = uint64_t(std::max(1, s.spp));
+  if (maxPasses * pixels_ >= (uint64_t(1) << 32))
+    throw Error("--spp " + std::to_string(s.spp) + " at " + std::to_string(s.width) + "x" + std::to_string(s.height) +
+                " is more than 2^32 samples in one render; render fewer");
+  passTable_host_.assign(maxPasses, 0);
+  passTable_ = buffer(maxPasses * 4, "pass table");
   FH_CL(dc.queue.enqueueFillBuffer(passBuffer_, 0u, 0, size_t(passSlots_) * pixels_ * 16));
   FH_CL(dc.queue.enqueueFillBuffer(filmSum_, 0u, 0, size_t(pixels_) * 16));
   FH_CL(dc.queue.enqueueFillBuffer(filmSumSq_, 0u, 0, size_t(pixels_) * 16));
@@ -228,8 +235,8 @@ void PathTracer::enqueueIteration(int current) {
   setArgs(plan_, counters_, rays, nextRays);
   run(plan_, 1, "bookkeeping");
 
-  setArgs(generate_, params_, counters_, freeList_, queue, filterTable_);
-  setPathArgs(generate_, 5, pathState_);
+  setArgs(generate_, params_, counters_, freeList_, queue, filterTable_, passTable_);
+  setPathArgs(generate_, 6, pathState_);
   run(generate_, wavefront_, "generate");
 
   setArgs(intersect_, scene_.caster.nodes(), scene_.caster.blocks(), queue, counters_, rays, pathState_[0],
@@ -264,79 +271,79 @@ void PathTracer::collectKernelTimes() {
   events_.clear();
 }
 
-// Adds every completed pass to the film, in pass order.
-void PathTracer::foldCompletedPasses(uint32_t* counters, uint64_t& passesDone) {
-  const uint64_t started = counters[FH_COUNT_NEXT_SAMPLE];
-  for (;;) {
-    const unsigned slot = unsigned(passesDone % passSlots_);
-    if (counters[FH_COUNT_PASS_DONE + slot] != pixels_ || passesDone * pixels_ >= started) return;
-    setArgs(accumulatePass_, passBuffer_, unsigned(passesDone), pixels_, filmSum_, filmSumSq_);
-    cl::Event e;
-    launch(dc_, accumulatePass_, pixels_, "accumulate_pass", &e);
-    // The counter may have grown on the device since it was read only if the next pass
-    // using this slot had started, which the sample limit rules out: resetting is safe.
-    static const uint32_t zero = 0;
-    FH_CL(dc_.queue.enqueueWriteBuffer(counters_, CL_FALSE, (FH_COUNT_PASS_DONE + slot) * 4, 4, &zero));
-    events_.emplace_back("accumulate", e);
-    counters[FH_COUNT_PASS_DONE + slot] = 0;
-    ++passesDone;
-  }
-}
+// One render's bookkeeping on the host: which global pass each local pass is, and how
+// finished passes leave the device (folded into its film, or handed to a PassSource).
+struct PathTracer::Run {
+  std::function<bool(uint32_t&)> take;     // the next global pass, if any
+  PassSource* source = nullptr;            // null: fold into the device's film
+  std::function<void(double)> onProgress;  // after each counter read: elapsed seconds
+  uint64_t granted = 0, folded = 0;        // local passes
+};
 
-Film PathTracer::render() {
+// Queues iterations in batches, reading the counters once per batch: finished passes are
+// folded (in local order), new passes granted while fewer than passSlots_ are in flight.
+void PathTracer::run(Run& r) {
   const auto start = Clock::now();
-  const uint64_t pixels = pixels_;
-  const uint64_t maxSamples = uint64_t(std::max(1, settings_.spp)) * pixels;
-  if (maxSamples >= (uint64_t(1) << 32))
-    throw Error("--spp " + std::to_string(settings_.spp) + " at " + std::to_string(settings_.width) + "x" +
-                std::to_string(settings_.height) + " is more than 2^32 samples in one render; render fewer");
-  uint64_t limit = maxSamples;  // shrinks to the end of the running pass when time is up
-  uint64_t passesDone = 0;
-  Progress progress(settings_.progress);
   stats_ = RenderStats{};
   stats_.device = dc_.info.name;
   stats_.wavefront = wavefront_;
-
   uint32_t counters[FH_COUNT_TOTAL] = {};
   counters[FH_COUNT_FREE] = unsigned(wavefront_);
-  // Pass p + passSlots reuses pass p's buffer: it may start once pass p is folded in.
-  auto sampleLimit = [&] { return uint32_t(std::min(limit, (passesDone + passSlots_) * pixels)); };
-  counters[FH_COUNT_SAMPLE_LIMIT] = sampleLimit();
+
+  auto grant = [&] {
+    uint32_t pass;
+    while (r.granted - r.folded < passSlots_ && r.granted < passTable_host_.size() && r.take(pass)) {
+      passTable_host_[r.granted] = pass;
+      FH_CL(dc_.queue.enqueueWriteBuffer(passTable_, CL_FALSE, r.granted * 4, 4, &passTable_host_[r.granted]));
+      ++r.granted;
+    }
+    counters[FH_COUNT_SAMPLE_LIMIT] = uint32_t(r.granted * pixels_);
+  };
+  grant();
   FH_CL(dc_.queue.enqueueWriteBuffer(counters_, CL_TRUE, 0, sizeof counters, counters));
 
-  // Iterations are queued in batches; the host reads the counters once per batch.
   const int batch = 8;
   int current = 0;
-  while (passesDone * pixels < limit) {
+  std::vector<float> samples;
+  while (r.folded < r.granted) {
     for (int k = 0; k < batch; ++k, current = 1 - current) enqueueIteration(current);
     FH_CL(dc_.queue.enqueueReadBuffer(counters_, CL_TRUE, 0, sizeof counters, counters));
     collectKernelTimes();
-    foldCompletedPasses(counters, passesDone);
 
-    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    if (settings_.seconds > 0.0 && elapsed >= settings_.seconds && limit == maxSamples)
-      limit = std::max<uint64_t>(1, (uint64_t(counters[FH_COUNT_NEXT_SAMPLE]) + pixels - 1) / pixels) * pixels;
-    const uint32_t newLimit = sampleLimit();
-    if (newLimit != counters[FH_COUNT_SAMPLE_LIMIT]) {
-      counters[FH_COUNT_SAMPLE_LIMIT] = newLimit;
+    // Fold every completed pass, in local pass order.
+    for (;;) {
+      const unsigned slot = unsigned(r.folded % passSlots_);
+      if (r.folded == r.granted || counters[FH_COUNT_PASS_DONE + slot] != pixels_) break;
+      const size_t offset = size_t(slot) * pixels_ * 16;
+      if (r.source) {
+        samples.resize(size_t(pixels_) * 4);
+        FH_CL(dc_.queue.enqueueReadBuffer(passBuffer_, CL_TRUE, offset, samples.size() * 4, samples.data()));
+        FH_CL(dc_.queue.enqueueFillBuffer(passBuffer_, 0u, offset, size_t(pixels_) * 16));
+        r.source->done(passTable_host_[r.folded], samples);
+      } else {
+        setArgs(accumulatePass_, passBuffer_, unsigned(r.folded), pixels_, filmSum_, filmSumSq_);
+        cl::Event e;
+        launch(dc_, accumulatePass_, pixels_, "accumulate_pass", &e);
+        events_.emplace_back("accumulate", e);
+      }
+      // Safe to reset: the next pass using this slot has not been granted yet.
+      static const uint32_t zero = 0;
+      FH_CL(dc_.queue.enqueueWriteBuffer(counters_, CL_FALSE, (FH_COUNT_PASS_DONE + slot) * 4, 4, &zero));
+      counters[FH_COUNT_PASS_DONE + slot] = 0;
+      ++r.folded;
+    }
+    const uint32_t before = counters[FH_COUNT_SAMPLE_LIMIT];
+    grant();
+    if (counters[FH_COUNT_SAMPLE_LIMIT] != before)
       FH_CL(dc_.queue.enqueueWriteBuffer(counters_, CL_FALSE, FH_COUNT_SAMPLE_LIMIT * 4, 4,
                                          &counters[FH_COUNT_SAMPLE_LIMIT]));
-    }
-    progress.update(passesDone * pixels, settings_.seconds > 0.0 ? 0 : maxSamples, elapsed,
-                    settings_.seconds > 0.0 ? std::min(1.0, elapsed / settings_.seconds) : 0.0);
+    if (r.onProgress) r.onProgress(std::chrono::duration<double>(Clock::now() - start).count());
   }
   FH_CL(dc_.queue.finish());
   collectKernelTimes();
 
-  Film film;
-  film.width = settings_.width;
-  film.height = settings_.height;
-  film.sum.resize(size_t(pixels) * 4);
-  film.sumSq.resize(size_t(pixels) * 4);
-  FH_CL(dc_.queue.enqueueReadBuffer(filmSum_, CL_TRUE, 0, film.sum.size() * 4, film.sum.data()));
-  FH_CL(dc_.queue.enqueueReadBuffer(filmSumSq_, CL_TRUE, 0, film.sumSq.size() * 4, film.sumSq.data()));
   auto total64 = [&](int index) { return uint64_t(counters[index]) | uint64_t(counters[index + 1]) << 32; };
-  stats_.samples = passesDone * pixels;
+  stats_.samples = r.folded * pixels_;
   stats_.cameraRays = counters[FH_COUNT_NEXT_SAMPLE];
   stats_.bounceRays = total64(FH_COUNT_BOUNCE_RAYS);
   stats_.shadowRays = total64(FH_COUNT_SHADOW_RAYS);
@@ -345,8 +352,44 @@ Film PathTracer::render() {
   stats_.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   stats_.meanQueueOccupancy =
       stats_.iterations ? double(total64(FH_COUNT_QUEUED_RAYS)) / double(stats_.iterations * wavefront_) : 0.0;
+}
+
+Film PathTracer::render() {
+  const uint64_t passes = uint64_t(std::max(1, settings_.spp));
+  uint32_t next = 0;
+  bool outOfTime = false;
+  Progress progress(settings_.progress);
+  Run r;
+  // With a time budget, passes stop being handed out once it is spent; those already
+  // started finish, so every pixel ends with the same sample count.
+  r.take = [&](uint32_t& pass) {
+    if (next >= passes || outOfTime) return false;
+    pass = next++;
+    return true;
+  };
+  r.onProgress = [&](double elapsed) {
+    outOfTime = settings_.seconds > 0.0 && elapsed >= settings_.seconds;
+    progress.update(r.folded * pixels_, settings_.seconds > 0.0 ? 0 : passes * pixels_, elapsed,
+                    settings_.seconds > 0.0 ? std::min(1.0, elapsed / settings_.seconds) : 0.0);
+  };
+  run(r);
   progress.finish(stats_.samples, stats_.seconds);
+
+  Film film;
+  film.width = settings_.width;
+  film.height = settings_.height;
+  film.sum.resize(size_t(pixels_) * 4);
+  film.sumSq.resize(size_t(pixels_) * 4);
+  FH_CL(dc_.queue.enqueueReadBuffer(filmSum_, CL_TRUE, 0, film.sum.size() * 4, film.sum.data()));
+  FH_CL(dc_.queue.enqueueReadBuffer(filmSumSq_, CL_TRUE, 0, film.sumSq.size() * 4, film.sumSq.data()));
   return film;
+}
+
+void PathTracer::renderPasses(PassSource& source) {
+  Run r;
+  r.take = [&](uint32_t& pass) { return source.take(pass); };
+  r.source = &source;
+  run(r);
 }
 
 }  // namespace fh

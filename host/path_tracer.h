@@ -3,6 +3,8 @@
 // refilling finished paths with new camera samples so the queues stay full.
 #pragma once
 #include <array>
+#include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -68,17 +70,31 @@ std::string statsJson(const RenderStats& stats, const RenderSettings& settings);
 // path state should stay near the caches; never more than two passes of pixels.
 size_t defaultWavefront(const DeviceInfo& device, size_t pixels);
 
+// Where a device's passes come from when several devices share a render: take() hands
+// out the next global pass (false when none is left), done() receives a finished pass's
+// per-pixel samples (rgb, 1 per pixel; pixel-major). Called from the device's thread.
+class PassSource {
+ public:
+  virtual ~PassSource() = default;
+  virtual bool take(uint32_t& pass) = 0;
+  virtual void done(uint32_t pass, std::vector<float>& samples) = 0;
+};
+
 class PathTracer {
  public:
   PathTracer(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const Camera& camera, const RenderSettings& s);
+  // Renders passes 0 .. spp-1 (or as many as --time allows) into the device's own film.
   Film render();
+  // Renders the passes `source` hands out, returning each to it as soon as it is done.
+  void renderPasses(PassSource& source);
   const RenderStats& stats() const { return stats_; }
+  unsigned passSlots() const { return passSlots_; }
 
  private:
-  struct Launch;
+  struct Run;
   void enqueueIteration(int current);
   void collectKernelTimes();
-  void foldCompletedPasses(uint32_t* counters, uint64_t& passesDone);
+  void run(Run& run);
   void timeKernel(const char* name, const cl::Event& event);
 
   DeviceContext& dc_;
@@ -89,7 +105,9 @@ class PathTracer {
   unsigned pixels_;
   unsigned passSlots_;  // passes in flight at most
   std::vector<cl::Buffer> pathState_, shadowRequests_;
-  cl::Buffer rayQueue_[2], finishedQueue_, freeList_, counters_, passBuffer_, filmSum_, filmSumSq_, filterTable_;
+  cl::Buffer rayQueue_[2], finishedQueue_, freeList_, counters_, passBuffer_, filmSum_, filmSumSq_, filterTable_,
+      passTable_;
+  std::vector<uint32_t> passTable_host_;  // global pass of each local pass (stable storage for writes)
   cl::Kernel plan_, generate_, intersect_, shade_, shadowConnect_, accumulatePaths_, finish_, accumulatePass_;
   std::vector<std::pair<const char*, cl::Event>> events_;
   RenderStats stats_;

@@ -14,8 +14,7 @@ __kernel void accumulate_paths(__global const uint* finished_queue, volatile __g
   barrier(CLK_LOCAL_MEM_FENCE);
   if (i < counters[FH_COUNT_FINISHED]) {
     const uint p = finished_queue[i];
-    const uint k = sample_id[p];
-    const uint pixel = k % pixel_count, slot = (k / pixel_count) % FH_PASS_SLOTS;
+    const uint pixel = sample_id[p] % pixel_count, slot = local_pass[p] % FH_PASS_SLOTS;
     float3 value = radiance[p].xyz;
     if (!all(isfinite(value))) {
       // Counted and reported (stats: nonfinite_samples); the tests require zero.

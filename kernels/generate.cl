@@ -27,14 +27,20 @@ __kernel void plan_iteration(volatile __global uint* counters, uint ray_counter,
 }
 
 // Starts the planned samples in the slots on top of the free list and appends them to
-// the ray queue. Sample k is pixel k % pixel_count of pass k / pixel_count.
+// the ray queue. A device numbers its samples locally (j); its passes are granted by the
+// host, which may hand different passes to different devices: local pass j / pixel_count
+// is global pass pass_table[j / pixel_count]. Global sample k = pass * pixel_count + pixel
+// seeds the random numbers, so a sample is the same whichever device renders it.
 __kernel void generate_paths(RenderParams params, __global const uint* counters, __global const uint* free_list,
-                             __global uint* ray_queue, __global const float* filter_table FH_PATH_PARAMS) {
+                             __global uint* ray_queue, __global const float* filter_table,
+                             __global const uint* pass_table FH_PATH_PARAMS) {
   const uint i = get_global_id(0);
   if (i >= counters[FH_COUNT_GEN_COUNT]) return;
   const uint slot = free_list[counters[FH_COUNT_GEN_FREE_TOP] - 1 - i];
-  const uint k = counters[FH_COUNT_GEN_FIRST] + i;
-  const uint pixel = k % params.pixel_count, pass = k / params.pixel_count;
+  const uint j = counters[FH_COUNT_GEN_FIRST] + i;
+  const uint pixel = j % params.pixel_count, device_pass = j / params.pixel_count;
+  const uint pass = pass_table[device_pass];
+  const uint k = pass * params.pixel_count + pixel;
   const float2 u = pixel_sample_2d(params.seed, pixel, pass);
   const float px = (float)(pixel % (uint)params.camera.width) + 0.5f +
                    filter_offset(filter_table, params.filter_table_size, u.x);
@@ -45,6 +51,7 @@ __kernel void generate_paths(RenderParams params, __global const uint* counters,
   throughput[slot] = (float4)(1.0f, 1.0f, 1.0f, 0.0f);
   radiance[slot] = (float4)(0.0f);
   sample_id[slot] = k;
+  local_pass[slot] = device_pass;
   depth[slot] = 0;
   ray_queue[counters[FH_COUNT_GEN_QUEUE_BASE] + i] = slot;
 }

@@ -14,6 +14,7 @@
   X(float4, throughput, 16)     /* rgb; w: pdf of the BSDF sample that made ray_dir (for MIS) */ \
   X(float4, radiance, 16)       /* rgb gathered so far */                                        \
   X(uint, sample_id, 4)         /* global sample index: pixel = id % pixels, pass = id / pixels */ \
+  X(uint, local_pass, 4)        /* this device's pass number for the sample: its pass buffer */    \
   X(uint, depth, 4)             /* bounces so far */
 
 // The light-sample requests shade hands to shadow_connect, stored by queue position (so
@@ -40,8 +41,8 @@
 #define FH_COUNT_FINISHED 3       // paths finished this iteration
 #define FH_COUNT_NONFINITE 4      // samples whose radiance was NaN or infinite (dropped)
 #define FH_COUNT_FREE 5           // free path slots: the free list's length
-#define FH_COUNT_NEXT_SAMPLE 6    // samples started so far
-#define FH_COUNT_SAMPLE_LIMIT 7   // samples that may start (the host moves it)
+#define FH_COUNT_NEXT_SAMPLE 6    // samples started so far on this device (local numbering)
+#define FH_COUNT_SAMPLE_LIMIT 7   // local samples that may start: the passes granted so far
 #define FH_COUNT_GEN_COUNT 8      // this iteration's new samples
 #define FH_COUNT_GEN_FIRST 9      // ... the first one's index
 #define FH_COUNT_GEN_FREE_TOP 10  // ... the free list's length before they took their slots
