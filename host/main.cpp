@@ -13,6 +13,7 @@
 #include "devices.h"
 #include "error.h"
 #include "image_io.h"
+#include "multi_device.h"
 #include "path_tracer.h"
 #include "render_aov.h"
 #include "scene_loader.h"
@@ -106,17 +107,12 @@ int runRender(RenderOptions o) {
     throw Error("--stats '" + o.statsFile + "': file exists (pass --force to overwrite it)");
 
   const auto devices = selectDevices(listDevices(), o.device);
-  if (devices.size() > 1)
-    std::cerr << "fredholm: note: rendering on the first selected device (" << devices[0].name
-              << "); several devices per render come with multi-device support\n";
 
   const Scene scene = o.scene.empty() ? loadDefaultScene() : loadScene(o.scene);
   printWarnings(scene);
   const Camera camera = chooseCamera(o, scene);
   const auto start = std::chrono::steady_clock::now();
   const Bvh bvh = buildBvh(scene);
-  DeviceContext dc(devices[0]);
-
   Image image;
   std::string method;
   uint64_t samples = 0;
@@ -127,6 +123,7 @@ int runRender(RenderOptions o) {
     a.spp = spp;
     a.seed = o.seed;
     a.mode = aov;
+    DeviceContext dc(devices[0]);
     image = renderAov(dc, scene, bvh, camera, a);
     method = "aov:" + o.aov;
     samples = uint64_t(spp) * uint64_t(o.width) * uint64_t(o.height);
@@ -139,17 +136,38 @@ int runRender(RenderOptions o) {
     settings.seed = o.seed;
     settings.wavefront = o.wavefront;
     settings.progress = true;
-    PathTracer tracer(dc, scene, bvh, camera, settings);
-    const Film film = tracer.render();
-    image = film.image();
+    RenderStats stats;
+    bool complete = true;
+    if (devices.size() == 1) {
+      DeviceContext dc(devices[0]);
+      PathTracer tracer(dc, scene, bvh, camera, settings);
+      image = tracer.render().image();
+      stats = tracer.stats();
+    } else {
+      MultiDeviceResult r = renderOnDevices(devices, scene, bvh, camera, settings);
+      image = r.film.image();
+      stats = r.stats;
+      complete = r.complete;
+      for (const auto& d : stats.devices)
+        if (!d.error.empty())
+          std::cerr << "fredholm: warning: device " << d.name << " failed: " << d.error
+                    << (complete ? "; the other devices rendered its passes" : "") << "\n";
+    }
     method = methodName(settings.method);
-    samples = tracer.stats().samples;
-    if (tracer.stats().nonfinite)
-      std::cerr << "fredholm: warning: " << tracer.stats().nonfinite << " samples were NaN or infinite and dropped\n";
+    samples = stats.samples;
+    if (stats.nonfinite)
+      std::cerr << "fredholm: warning: " << stats.nonfinite << " samples were NaN or infinite and dropped\n";
     if (!o.statsFile.empty()) {
       std::ofstream out(o.statsFile);
-      out << statsJson(tracer.stats(), settings) << "\n";
+      out << statsJson(stats, settings) << "\n";
       if (!out) throw Error("--stats '" + o.statsFile + "': cannot write");
+    }
+    if (!complete) {
+      writeImage(o.output, image, {{"scene", scene.sourcePath}, {"method", methodName(settings.method)},
+                                   {"incomplete", "every device failed"}});
+      throw Error("every device failed before the render was complete; wrote the " +
+                  std::to_string(samples / (uint64_t(o.width) * o.height)) + " passes finished so far to " +
+                  o.output);
     }
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

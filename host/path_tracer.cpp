@@ -109,6 +109,27 @@ std::array<double, 3> Film::varianceOfMean(size_t p) const {
   return v;
 }
 
+nlohmann::json devicesJson(const RenderStats& st) {
+  if (st.devices.empty())
+    return nlohmann::json::array({{{"name", st.device},
+                                   {"samples", st.samples},
+                                   {"samples_per_second", st.seconds > 0 ? double(st.samples) / st.seconds : 0.0},
+                                   {"share", 1.0},
+                                   {"idle_seconds", 0.0}}});
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& d : st.devices) {
+    nlohmann::json entry = {{"name", d.name},
+                            {"samples", d.samples},
+                            {"samples_per_second", d.busySeconds > 0 ? double(d.samples) / d.busySeconds : 0.0},
+                            {"share", st.samples ? double(d.samples) / double(st.samples) : 0.0},
+                            {"busy_seconds", d.busySeconds},
+                            {"idle_seconds", d.idleSeconds}};
+    if (!d.error.empty()) entry["error"] = d.error;
+    list.push_back(entry);
+  }
+  return list;
+}
+
 std::string statsJson(const RenderStats& st, const RenderSettings& s) {
   nlohmann::json kernels = nlohmann::json::object();
   double kernelTotal = 0.0;
@@ -121,7 +142,7 @@ std::string statsJson(const RenderStats& st, const RenderSettings& s) {
       {"seconds", st.seconds},
       {"samples_per_second", st.seconds > 0 ? double(st.samples) / st.seconds : 0.0},
       {"nonfinite_samples", st.nonfinite},
-      {"devices", nlohmann::json::array({{{"name", st.device}, {"samples", st.samples}}})},
+      {"devices", devicesJson(st)},
       {"method", methodName(s.method)},
       {"width", s.width},
       {"height", s.height},

@@ -52,6 +52,14 @@ struct Film {
 };
 
 struct RenderStats {
+  // With several devices: each one's share ({name, samples, seconds busy, idle, error}).
+  struct DeviceShare {
+    std::string name;
+    uint64_t samples = 0;
+    double busySeconds = 0.0, idleSeconds = 0.0;
+    std::string error;  // why the device stopped early, if it did
+  };
+  std::vector<DeviceShare> devices;
   std::string device;
   uint64_t samples = 0, nonfinite = 0;
   double seconds = 0.0;

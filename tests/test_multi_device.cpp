@@ -1,0 +1,161 @@
+// Several devices sharing one render, on PoCL's two CPU devices (POCL_DEVICES is set
+// before OpenCL loads): both devices work, the merged image is the single-device
+// estimator (the same samples: equal to float rounding for one seed, statistically equal
+// across seeds), deterministic, and a device that fails mid-render loses no work and
+// counts none twice.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "multi_device.h"
+#include "scene_loader.h"
+#include "test_support.h"
+
+namespace fh {
+namespace {
+
+struct TwoDevices : ::testing::Test {
+  static void SetUpTestSuite() { setenv("POCL_DEVICES", "pthread pthread", 1); }
+  std::vector<DeviceInfo> devices() {
+    auto all = selectDevices(listDevices(), "all");
+    if (all.size() < 2) ADD_FAILURE() << "POCL_DEVICES gave " << all.size() << " device(s)";
+    return all;
+  }
+  Scene scene = loadDefaultScene();
+  Bvh bvh = buildBvh(scene);
+  RenderSettings settings = [] {
+    RenderSettings s;
+    s.width = s.height = 24;
+    s.spp = 64;
+    s.seed = 9;
+    return s;
+  }();
+};
+
+TEST_F(TwoDevices, BothWorkAndTheMergeEqualsOneDevicesSamples) {
+  const auto all = devices();
+  ASSERT_GE(all.size(), 2u);
+  const MultiDeviceResult multi = renderOnDevices(all, scene, bvh, scene.camera, settings);
+  ASSERT_TRUE(multi.complete);
+  EXPECT_EQ(multi.stats.samples, 24u * 24u * 64u);
+  uint64_t total = 0;
+  for (const auto& d : multi.stats.devices) {
+    EXPECT_GT(d.samples, 0u) << d.name << " did no work";
+    EXPECT_TRUE(d.error.empty()) << d.error;
+    total += d.samples;
+  }
+  EXPECT_EQ(total, multi.stats.samples);
+
+  DeviceContext dc(all[0]);
+  PathTracer single(dc, scene, bvh, scene.camera, settings);
+  const Film one = single.render();
+  // The same global samples whoever renders them: only the summation differs (the
+  // device sums in float, the merge in double).
+  for (size_t i = 0; i < one.sum.size(); ++i)
+    ASSERT_NEAR(multi.film.sum[i], one.sum[i], 1e-4 * std::max(1.0f, std::fabs(one.sum[i]))) << i;
+}
+
+TEST_F(TwoDevices, MergedImageMatchesAnIndependentSingleDeviceRender) {
+  const auto all = devices();
+  ASSERT_GE(all.size(), 2u);
+  settings.spp = 128;
+  const MultiDeviceResult multi = renderOnDevices(all, scene, bvh, scene.camera, settings);
+  DeviceContext dc(all[0]);
+  RenderSettings other = settings;
+  other.seed = 10;
+  PathTracer single(dc, scene, bvh, scene.camera, other);
+  const Film one = single.render();
+  // Image means over 4x4 blocks, z-tests with the two renders' own variances.
+  double diff = 0, var = 0;
+  int outliers = 0, blocks = 0;
+  for (int by = 0; by < 6; ++by)
+    for (int bx = 0; bx < 6; ++bx) {
+      double d = 0, v = 0;
+      for (int y = by * 4; y < by * 4 + 4; ++y)
+        for (int x = bx * 4; x < bx * 4 + 4; ++x) {
+          const size_t p = size_t(y * 24 + x);
+          for (int c = 0; c < 3; ++c) {
+            d += (multi.film.sum[4 * p + size_t(c)] / multi.film.count(p) - one.sum[4 * p + size_t(c)] / one.count(p)) / 48;
+            v += (multi.film.varianceOfMean(p)[size_t(c)] + one.varianceOfMean(p)[size_t(c)]) / (48.0 * 48.0) * 3;
+          }
+        }
+      diff += d;
+      var += v;
+      ++blocks;
+      if (std::fabs(d) > 3.29 * std::sqrt(v)) ++outliers;
+    }
+  EXPECT_LT(std::fabs(diff / std::sqrt(var)), 4.0);
+  EXPECT_LE(outliers, 2) << outliers << " of " << blocks << " blocks outside 3.29 sigma";
+}
+
+TEST_F(TwoDevices, DeterministicForASeedAndDeviceList) {
+  const auto all = devices();
+  const MultiDeviceResult a = renderOnDevices(all, scene, bvh, scene.camera, settings);
+  const MultiDeviceResult b = renderOnDevices(all, scene, bvh, scene.camera, settings);
+  EXPECT_EQ(a.film.sum, b.film.sum);
+  EXPECT_EQ(a.film.sumSq, b.film.sumSq);
+}
+
+TEST_F(TwoDevices, AFailingDeviceLosesNothingAndCountsNothingTwice) {
+  const auto all = devices();
+  const MultiDeviceResult reference = renderOnDevices(all, scene, bvh, scene.camera, settings);
+  setenv("FREDHOLM_FAIL_DEVICE", "1:3", 1);
+  const MultiDeviceResult failed = renderOnDevices(all, scene, bvh, scene.camera, settings);
+  unsetenv("FREDHOLM_FAIL_DEVICE");
+  ASSERT_TRUE(failed.complete);
+  EXPECT_NE(failed.stats.devices[1].error.find("simulated failure"), std::string::npos);
+  EXPECT_EQ(failed.stats.devices[1].samples, 3u * 24u * 24u);  // the passes it finished before failing
+  EXPECT_EQ(failed.stats.samples, 24u * 24u * 64u);
+  // Every pass exactly once: the same image as without the failure.
+  EXPECT_EQ(failed.film.sum, reference.film.sum);
+}
+
+TEST_F(TwoDevices, WhenEveryDeviceFailsTheImageSoFarIsKept) {
+  const auto all = devices();
+  setenv("FREDHOLM_FAIL_DEVICE", "0:2", 1);
+  const MultiDeviceResult r = renderOnDevices({all[0]}, scene, bvh, scene.camera, settings);
+  unsetenv("FREDHOLM_FAIL_DEVICE");
+  EXPECT_FALSE(r.complete);
+  EXPECT_EQ(r.stats.samples, 2u * 24u * 24u);
+  for (size_t p = 0; p < 24u * 24u; ++p) EXPECT_EQ(r.film.count(p), 2.0) << p;
+}
+
+TEST(MultiDeviceCli, UnequalPairBothWorkAndStatsReportShares) {
+  const std::string dir = test::tempDir("multi");
+  // A first, small render compiles the kernels for both devices (kernel caches), so the
+  // slow device is not still compiling while the fast one takes every pass.
+  const std::string env = "POCL_DEVICES='basic pthread'";
+  ASSERT_EQ(test::runFredholm("render --device all --width 16 --height 16 --spp 4 -o " + dir + "/warm.png", env)
+                .exitCode,
+            0);
+  const auto r = test::runFredholm("render --device all --width 128 --height 128 --spp 64 -o " + dir +
+                                       "/m.exr --stats " + dir + "/s.json",
+                                   env);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  std::ifstream in(dir + "/s.json");
+  const auto stats = nlohmann::json::parse(in);
+  ASSERT_EQ(stats["devices"].size(), 2u);
+  double shares = 0;
+  for (const auto& d : stats["devices"]) {
+    EXPECT_GT(d["samples"].get<uint64_t>(), 0u) << d;
+    EXPECT_GT(d["samples_per_second"].get<double>(), 0.0) << d;
+    EXPECT_TRUE(d.contains("idle_seconds")) << d;
+    shares += d["share"].get<double>();
+  }
+  EXPECT_NEAR(shares, 1.0, 1e-9);
+  EXPECT_EQ(stats["samples"], 128 * 128 * 64);
+}
+
+TEST(MultiDeviceCli, FailureIsReportedAndTheRenderFinishes) {
+  const std::string dir = test::tempDir("multi");
+  const auto r = test::runFredholm("render --device all --width 32 --height 32 --spp 16 -o " + dir + "/m.png",
+                                   "POCL_DEVICES='pthread pthread' FREDHOLM_FAIL_DEVICE=1:2");
+  EXPECT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("fredholm: warning: device"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("the other devices rendered its passes"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace fh
