@@ -23,7 +23,8 @@
   X(uint, shadow_path, 4)           /* the path slot the contribution goes to */             \
   X(float4, shadow_position, 16)    /* shading point, w: its magnitude (for ray offsets) */  \
   X(float4, shadow_normal, 16)      /* geometric normal on the viewer's side, w: material */ \
-  X(float4, shadow_throughput, 16)  /* throughput before the BSDF sample, w: bounce count */
+  X(float4, shadow_throughput, 16)  /* throughput before the BSDF sample, w: bounce count */ \
+  X(float4, shadow_wo, 16)          /* direction toward the previous vertex */
 
 #ifdef __OPENCL_VERSION__
 #define FH_PATH_PARAM(type, name, bytes) , __global type* name

@@ -3,9 +3,11 @@
 #ifndef FH_SAMPLING_H
 #define FH_SAMPLING_H
 
+#include "types.h"
+
 // A right-handed basis (t, b, n) around unit n (Duff et al., "Building an Orthonormal
 // Basis, Revisited", JCGT 2017).
-inline void orthonormal_basis(float3 n, float3* t, float3* b) {
+FH_INLINE void orthonormal_basis(float3 n, float3* t, float3* b) {
   const float sign = copysign(1.0f, n.z);
   const float a = -1.0f / (sign + n.z);
   const float c = n.x * n.y * a;
@@ -47,7 +49,7 @@ FH_INLINE float3 sample_cosine_hemisphere(float3 n, float u1, float u2) {
 }
 
 // Barycentrics (b1, b2) of a uniform point on a triangle.
-inline float2 sample_triangle(float u1, float u2) {
+FH_INLINE float2 sample_triangle(float u1, float u2) {
   const float su = sqrt(u1);
   return (float2)(su * u2, 1.0f - su);
 }

@@ -19,15 +19,18 @@
 #define FH_DIM_BSDF_U1 0
 #define FH_DIM_BSDF_U2 1
 #define FH_DIM_ROULETTE 2
+#define FH_DIM_BSDF_LOBE 6
 
-// The weight of emission found by BSDF sampling at a vertex `depth` bounces from the camera.
+// The weight of emission found by BSDF sampling at a vertex `depth` bounces from the
+// camera; bsdf_pdf < 0 marks a delta (mirror, glass) bounce, which light sampling
+// cannot reproduce, so its emission always counts.
 FH_INLINE float emission_weight(uint depth, float bsdf_pdf, float light_pdf_area, float dist2, float cos_light) {
 #if defined(FH_METHOD_PT)
   return 1.0f;
 #elif defined(FH_METHOD_NEE)
-  return depth == 0 ? 1.0f : 0.0f;  // light sampling already counted it
+  return depth == 0 || bsdf_pdf < 0.0f ? 1.0f : 0.0f;  // light sampling counted the rest
 #else
-  if (depth == 0) return 1.0f;
+  if (depth == 0 || bsdf_pdf < 0.0f) return 1.0f;
   return power_heuristic(bsdf_pdf, area_to_solid_angle(light_pdf_area, dist2, cos_light));
 #endif
 }
@@ -44,6 +47,7 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
   uint p = 0;
   // What a light-sample request needs, kept until its queue position is known.
   float4 request_position = (float4)(0.0f), request_normal = (float4)(0.0f), request_beta = (float4)(0.0f);
+  float3 request_wo = (float3)(0.0f);
 
   if (i < count) {
     p = ray_queue[i];
@@ -68,27 +72,30 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
       if (cos_front > 0.0f && (ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f))
         gathered += beta.xyz * ke * emission_weight(bounce, beta.w, light_pdf_area[t], h.x * h.x, cos_front);
 
-      // Two-sided shading: the normal on the viewer's side.
+      // Two-sided shading for opaque surfaces: the normal on the viewer's side.
       const float3 n = cos_front >= 0.0f ? s.normal : -s.normal;
       const bool may_bounce = bounce + 1 <= params.max_depth;
+      const Bsdf bsdf = material_bsdf(m);
 
 #if !defined(FH_METHOD_PT)
-      light_sample = may_bounce && params.light_count > 0;
+      light_sample = may_bounce && params.light_count > 0 && bsdf_has_smooth_lobe(&bsdf);
       request_position = (float4)(s.position, s.magnitude);
       request_normal = (float4)(n, as_float(material_id));
       request_beta = (float4)(beta.xyz, as_float(bounce));
+      request_wo = wo;
 #endif
 
       if (may_bounce) {
         const uint dim = bounce * FH_DIMS_PER_BOUNCE;
         const uint rng = rng_stream(params.seed, sample_id[p]);
-        const Bsdf bsdf = material_bsdf(m);
         float3 wi;
         float pdf;
-        const float3 weight = bsdf_sample(&bsdf, n, random_in_stream(rng, dim + FH_DIM_BSDF_U1),
-                                          random_in_stream(rng, dim + FH_DIM_BSDF_U2), &wi, &pdf);
+        const float3 weight =
+            bsdf_sample(&bsdf, s.normal, wo, random_in_stream(rng, dim + FH_DIM_BSDF_LOBE),
+                        random_in_stream(rng, dim + FH_DIM_BSDF_U1), random_in_stream(rng, dim + FH_DIM_BSDF_U2),
+                        &wi, &pdf);
         beta = (float4)(beta.xyz * weight, pdf);
-        continues = pdf > 0.0f;
+        continues = pdf != 0.0f;
         // Russian roulette: survive with a probability from the throughput (capped, so
         // bright paths still end); dividing by it keeps the estimator unbiased.
         if (continues && bounce + 1 >= params.rr_depth) {
@@ -117,6 +124,7 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
     shadow_position[request] = request_position;
     shadow_normal[request] = request_normal;
     shadow_throughput[request] = request_beta;
+    shadow_wo[request] = (float4)(request_wo, 0.0f);
   }
   const uint done = group_append(finishes, &counters[FH_COUNT_FINISHED], scratch);
   if (finishes) finished_queue[done] = p;

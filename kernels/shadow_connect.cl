@@ -45,10 +45,11 @@ __kernel void shadow_connect(RenderParams params, volatile __global uint* counte
   if (cos_surface <= 0.0f || cos_light <= 0.0f) return;  // behind the surface, or the light's back
 
   const Bsdf bsdf = material_bsdf(materials + as_int(normal.w));
-  const float3 f = bsdf_eval(&bsdf, s.normal, wi);
+  const float3 wo = shadow_wo[i].xyz;
+  const float3 f = bsdf_eval(&bsdf, s.normal, wo, wi);
   const float pdf_light = area_to_solid_angle(light_pdf_area[lt], dist2, cos_light);
 #if defined(FH_METHOD_MIS)
-  const float weight = power_heuristic(pdf_light, bsdf_pdf(s.normal, wi));
+  const float weight = power_heuristic(pdf_light, bsdf_pdf(&bsdf, s.normal, wo, wi));
 #else
   const float weight = 1.0f;
 #endif

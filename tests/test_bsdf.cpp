@@ -1,0 +1,277 @@
+// BSDFs on the device: the sampling of every smooth lobe against its pdf (chi-square
+// goodness of fit, as Mitsuba's chi2 test), energy (the estimated albedo never exceeds
+// one), and white furnaces: a lossless object (white diffuse, perfect mirror, clear glass)
+// inside a uniformly emitting, non-reflecting enclosure is invisible.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "device_scene.h"
+#include "kernel_sources.h"
+#include "path_tracer.h"
+#include "program.h"
+#include "scene_builder.h"
+#include "test_support.h"
+
+namespace fh {
+namespace {
+
+const char* kTestKernels = R"CL(
+__kernel void sample_bsdf(__global const GpuMaterial* m, float4 wo, uint seed, __global float4* wi_pdf,
+                          __global float4* weight) {
+  const uint i = get_global_id(0);
+  const Bsdf b = material_bsdf(m);
+  float3 wi;
+  float pdf;
+  const float3 w = bsdf_sample(&b, (float3)(0.0f, 0.0f, 1.0f), wo.xyz, random_float(seed, i, 0),
+                               random_float(seed, i, 1), random_float(seed, i, 2), &wi, &pdf);
+  wi_pdf[i] = (float4)(wi, pdf);
+  weight[i] = (float4)(w, 0.0f);
+}
+__kernel void pdf_bsdf(__global const GpuMaterial* m, float4 wo, __global const float4* wi, __global float* pdf) {
+  const uint i = get_global_id(0);
+  const Bsdf b = material_bsdf(m);
+  pdf[i] = bsdf_pdf(&b, (float3)(0.0f, 0.0f, 1.0f), wo.xyz, wi[i].xyz);
+}
+)CL";
+
+class BsdfOnDevice : public ::testing::Test {
+ protected:
+  DeviceContext dc{selectDevices(listDevices(), "").front()};
+  cl::Program program = buildProgramFromSource(
+      dc.context, dc.info.device, assembleKernelSources({"bsdf.h", "rng.h"}) + kTestKernels, "");
+
+  static gpu::GpuMaterial material(float kd, float ks, float ns, int illum, float ni = 1.5f, float tf = 1.f) {
+    Scene s;
+    Material m;
+    m.kd = {kd, kd, kd};
+    m.ks = {ks, ks, ks};
+    m.ns = ns;
+    m.illum = illum;
+    m.ni = ni;
+    m.tf = {tf, tf, tf};
+    s.materials.push_back(m);
+    return toGpuMaterials(s)[0];
+  }
+
+  struct Samples {
+    std::vector<float> wiPdf, weight;
+  };
+
+  Samples sample(const gpu::GpuMaterial& m, const float3& wo, size_t n, unsigned seed = 1) {
+    cl::Buffer mb = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, sizeof m, "material", &m);
+    cl::Buffer a = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, n * 16, "wi");
+    cl::Buffer b = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, n * 16, "weight");
+    cl::Kernel k = createKernel(program, "sample_bsdf");
+    const cl_float4 w{{wo[0], wo[1], wo[2], 0.f}};
+    FH_CL(k.setArg(0, mb));
+    FH_CL(k.setArg(1, w));
+    FH_CL(k.setArg(2, seed));
+    FH_CL(k.setArg(3, a));
+    FH_CL(k.setArg(4, b));
+    FH_CL(dc.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n), cl::NDRange(64)));
+    Samples s{std::vector<float>(n * 4), std::vector<float>(n * 4)};
+    FH_CL(dc.queue.enqueueReadBuffer(a, CL_TRUE, 0, n * 16, s.wiPdf.data()));
+    FH_CL(dc.queue.enqueueReadBuffer(b, CL_TRUE, 0, n * 16, s.weight.data()));
+    return s;
+  }
+
+  std::vector<float> pdf(const gpu::GpuMaterial& m, const float3& wo, const std::vector<float>& dirs) {
+    const size_t n = dirs.size() / 4;
+    cl::Buffer mb = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, sizeof m, "material", &m);
+    cl::Buffer d = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, n * 16, "dirs", dirs.data());
+    cl::Buffer out = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, n * 4, "pdf");
+    cl::Kernel k = createKernel(program, "pdf_bsdf");
+    const cl_float4 w{{wo[0], wo[1], wo[2], 0.f}};
+    FH_CL(k.setArg(0, mb));
+    FH_CL(k.setArg(1, w));
+    FH_CL(k.setArg(2, d));
+    FH_CL(k.setArg(3, out));
+    FH_CL(dc.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n), cl::NDRange(64)));
+    std::vector<float> p(n);
+    FH_CL(dc.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * 4, p.data()));
+    return p;
+  }
+};
+
+float3 fromAngle(float thetaDeg) {
+  const float t = thetaDeg * float(M_PI) / 180.f;
+  return {std::sin(t), 0.f, std::cos(t)};
+}
+
+// Upper quantile of the chi-square distribution (Wilson-Hilferty), for p close to 1.
+double chiSquareQuantile(double k, double z) {
+  const double c = 2.0 / (9.0 * k);
+  return k * std::pow(1.0 - c + z * std::sqrt(c), 3.0);
+}
+
+// z for an upper tail probability q (Acklam-free: a few Newton steps on erfc).
+double normalQuantile(double q) {
+  double z = 3.0;
+  for (int i = 0; i < 50; ++i) {
+    const double tail = 0.5 * std::erfc(z / std::sqrt(2.0)), density = std::exp(-0.5 * z * z) / std::sqrt(2 * M_PI);
+    z += (tail - q) / density;
+  }
+  return z;
+}
+
+struct LobeCase {
+  float kd, ks, ns;
+  int illum;
+  float thetaDeg;
+};
+
+const LobeCase kLobes[] = {
+    {0.f, 1.f, 8.f, 2, 10.f},   {0.f, 1.f, 8.f, 2, 60.f},   {0.f, 1.f, 40.f, 2, 30.f},  {0.f, 1.f, 40.f, 2, 80.f},
+    {0.f, 1.f, 200.f, 2, 45.f}, {0.5f, 0.3f, 20.f, 2, 40.f}, {0.8f, 0.f, 0.f, 1, 30.f}, {0.4f, 0.5f, 80.f, 2, 70.f},
+};
+
+TEST_F(BsdfOnDevice, SamplingMatchesThePdfChiSquare) {
+  const int thetaBins = 16, phiBins = 32, sub = 6;
+  const size_t n = 1 << 20;
+  // Significance 0.01 over all cases (Sidak).
+  const double alpha = 1.0 - std::pow(1.0 - 0.01, 1.0 / (sizeof kLobes / sizeof kLobes[0]));
+  for (const LobeCase& c : kLobes) {
+    const auto m = material(c.kd, c.ks, c.ns, c.illum);
+    const float3 wo = fromAngle(c.thetaDeg);
+    const Samples s = sample(m, wo, n);
+    // Histogram over (cos theta, phi) of the upper hemisphere: equal solid angle per cell.
+    std::vector<double> observed(size_t(thetaBins * phiBins), 0.0);
+    for (size_t i = 0; i < n; ++i) {
+      const float* w = &s.wiPdf[4 * i];
+      if (w[3] <= 0.f) continue;
+      const double z = std::clamp(double(w[2]), 0.0, 1.0 - 1e-12), phi = std::atan2(w[1], w[0]) + M_PI;
+      const int ti = std::min(thetaBins - 1, int(z * thetaBins)), pi = std::min(phiBins - 1, int(phi / (2 * M_PI) * phiBins));
+      observed[size_t(ti * phiBins + pi)] += 1;
+    }
+    // Expected counts: the pdf integrated over each cell on a sub x sub grid (d omega = dz dphi).
+    std::vector<float> dirs;
+    for (int ti = 0; ti < thetaBins; ++ti)
+      for (int pi = 0; pi < phiBins; ++pi)
+        for (int a = 0; a < sub; ++a)
+          for (int b = 0; b < sub; ++b) {
+            const double z = (ti + (a + 0.5) / sub) / thetaBins, phi = (pi + (b + 0.5) / sub) / phiBins * 2 * M_PI - M_PI;
+            const double r = std::sqrt(std::max(0.0, 1 - z * z));
+            dirs.insert(dirs.end(), {float(r * std::cos(phi)), float(r * std::sin(phi)), float(z), 0.f});
+          }
+    const std::vector<float> p = pdf(m, wo, dirs);
+    const double cellArea = (1.0 / thetaBins) * (2 * M_PI / phiBins) / (sub * sub);
+    std::vector<double> expected(observed.size(), 0.0);
+    for (size_t i = 0; i < p.size(); ++i) expected[i / size_t(sub * sub)] += p[i] * cellArea * double(n);
+    // Pool cells expecting fewer than 5 samples into one.
+    double chi2 = 0, poolObs = 0, poolExp = 0;
+    int dof = 0;
+    for (size_t i = 0; i < observed.size(); ++i) {
+      if (expected[i] < 5) {
+        poolObs += observed[i];
+        poolExp += expected[i];
+        continue;
+      }
+      chi2 += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
+      ++dof;
+    }
+    if (poolExp >= 5) {
+      chi2 += (poolObs - poolExp) * (poolObs - poolExp) / poolExp;
+      ++dof;
+    }
+    const double limit = chiSquareQuantile(dof - 1, normalQuantile(alpha));
+    EXPECT_LT(chi2, limit) << "kd " << c.kd << " ks " << c.ks << " Ns " << c.ns << " theta " << c.thetaDeg
+                           << ": chi2 " << chi2 << " with " << dof - 1 << " degrees of freedom";
+  }
+}
+
+TEST_F(BsdfOnDevice, AlbedoNeverExceedsOne) {
+  const size_t n = 1 << 18;
+  for (float kd : {0.f, 0.5f, 1.f})
+    for (float ks : {0.f, 0.3f, 1.f})
+      for (float ns : {2.f, 40.f, 500.f, 5000.f})
+        for (int illum : {2, 5})
+          for (float theta : {0.f, 30.f, 60.f, 85.f}) {
+            const auto m = material(kd, ks, ns, illum);
+            const Samples s = sample(m, fromAngle(theta), n);
+            double albedo = 0;
+            for (size_t i = 0; i < n; ++i) albedo += s.weight[4 * i];
+            albedo /= double(n);
+            EXPECT_LE(albedo, 1.01) << "kd " << kd << " ks " << ks << " Ns " << ns << " illum " << illum << " theta "
+                                    << theta;
+          }
+}
+
+TEST_F(BsdfOnDevice, GlassReflectsAndRefractsByFresnel) {
+  // At normal incidence on glass of index 1.5, F = ((1.5 - 1) / (1.5 + 1))^2 = 0.04.
+  const auto m = material(0.f, 0.f, 0.f, 7, 1.5f, 1.f);
+  const size_t n = 1 << 18;
+  const Samples s = sample(m, {0.f, 0.f, 1.f}, n);
+  size_t reflected = 0;
+  for (size_t i = 0; i < n; ++i) {
+    reflected += s.wiPdf[4 * i + 2] > 0.f;
+    ASSERT_LT(s.wiPdf[4 * i + 3], 0.f);  // a delta lobe
+  }
+  EXPECT_NEAR(double(reflected) / n, 0.04, 4 * std::sqrt(0.04 * 0.96 / n));
+  // Leaving the glass beyond the critical angle (41.8 degrees): total internal reflection.
+  const Samples inside = sample(m, {std::sin(0.9f), 0.f, -std::cos(0.9f)}, 4096);
+  for (size_t i = 0; i < 4096; ++i) EXPECT_LT(inside.wiPdf[4 * i + 2], 0.f) << "not reflected back inside";
+}
+
+// ---- White furnaces ----
+
+Scene furnaceWith(const Material& object) {
+  test::SceneBuilder b;
+  b.closedBoxInside({-2, -2, -2}, {2, 2, 2}, b.material(0.f, 1.f));  // emits 1, reflects nothing
+  Scene s = b.build();
+  // An icosahedron-ish closed object: an octahedron, faces wound outward.
+  s.materials.push_back(object);
+  const int m = int(s.materials.size() - 1);
+  const float3 v[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  const int faces[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  for (const auto& f : faces) {
+    const unsigned base = unsigned(s.vertexCount());
+    for (int k = 0; k < 3; ++k) s.positions.insert(s.positions.end(), v[f[k]].begin(), v[f[k]].end());
+    s.indices.insert(s.indices.end(), {base, base + 1, base + 2});
+    s.triangleMaterial.push_back(m);
+  }
+  return s;
+}
+
+TEST(WhiteFurnace, LosslessObjectsVanishInAUniformEnclosure) {
+  DeviceContext dc(selectDevices(listDevices(), "").front());
+  Material white, mirror, glass;
+  white.kd = {1, 1, 1};
+  white.illum = 1;
+  mirror.kd = {0, 0, 0};
+  mirror.ks = {1, 1, 1};
+  mirror.ns = 10000;
+  mirror.illum = 5;
+  glass.kd = {0, 0, 0};
+  glass.illum = 7;
+  glass.ni = 1.5f;
+  glass.tf = {1, 1, 1};
+  Camera camera;
+  camera.eye = {0.3f, 0.4f, 1.9f};
+  camera.target = {0, 0, 0};
+  camera.fovYDeg = 50.f;
+  for (const auto& [name, object] : {std::pair{"white diffuse", white}, {"mirror", mirror}, {"glass", glass}}) {
+    const Scene scene = furnaceWith(object);
+    const Bvh bvh = buildBvh(scene);
+    for (Method method : {Method::PT, Method::NEE, Method::MIS}) {
+      RenderSettings s;
+      s.width = s.height = 16;
+      s.spp = 64;
+      s.method = method;
+      PathTracer tracer(dc, scene, bvh, camera, s);
+      const Film film = tracer.render();
+      EXPECT_EQ(tracer.stats().nonfinite, 0u);
+      double mean = 0, var = 0;
+      for (size_t p = 0; p < 256; ++p) {
+        mean += film.sum[4 * p] / film.count(p) / 256;
+        var += film.varianceOfMean(p)[0] / (256.0 * 256.0);
+      }
+      // Lossless: exactly 1, up to noise (a mirror or glass object in a uniform field has
+      // zero variance except through numerics).
+      EXPECT_LT(std::fabs(mean - 1.0), 4 * std::sqrt(var) + 2e-3) << name << " " << methodName(method);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace fh
