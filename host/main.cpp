@@ -13,6 +13,7 @@
 #include "devices.h"
 #include "error.h"
 #include "image_io.h"
+#include "device_scene.h"
 #include "multi_device.h"
 #include "path_tracer.h"
 #include "render_aov.h"
@@ -34,6 +35,7 @@ struct RenderOptions {
   std::string method = "mis", filter = "box", env, statsFile;
   int maxDepth = 64;
   size_t wavefront = 0;
+  bool allFeatures = false;
   unsigned seed = 1;
   std::string cameraFile, eye, target, up;
   float fov = 0.f;
@@ -135,6 +137,7 @@ int runRender(RenderOptions o) {
     settings.maxDepth = o.maxDepth;
     settings.seed = o.seed;
     settings.wavefront = o.wavefront;
+    settings.allFeatures = o.allFeatures;
     settings.progress = true;
     RenderStats stats;
     bool complete = true;
@@ -177,7 +180,8 @@ int runRender(RenderOptions o) {
               {"device", devices[0].name}, {"seed", std::to_string(o.seed)}, {"seconds", formatSeconds(seconds)},
               {"filter", o.filter}, {"max_depth", std::to_string(o.maxDepth)}});
   std::cerr << "fredholm: rendered " << scene.sourcePath << " (" << scene.triangleCount() << " triangles, "
-            << scene.lights.size() << " emissive) with " << method << ", " << o.width << "x" << o.height << ", "
+            << scene.lights.size() << " emissive; " << (o.allFeatures ? "all features" : sceneFeatures(scene).describe())
+            << ") with " << method << ", " << o.width << "x" << o.height << ", "
             << spp_done << " spp on " << devices[0].name << " in " << formatSeconds(seconds) << " s\n";
   std::cout << "wrote " << o.output << "\n";
   return 0;
@@ -214,6 +218,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   rendering->add_option("--wavefront", render.wavefront, "Paths in flight (default: chosen for the device)");
   rendering->add_option("--stats", render.statsFile, "Write render statistics as JSON");
+  rendering->add_flag("--all-features", render.allFeatures,
+                      "Compile every material feature, not only the scene's (to measure specialization)");
   rendering->add_option("--seed", render.seed, "Random seed")->capture_default_str();
   rendering->add_option("--camera", render.cameraFile, "Camera JSON {eye,target,up,fov_y_deg}");
   rendering->add_option("--eye", render.eye, "Camera position x,y,z");

@@ -166,7 +166,7 @@ size_t defaultWavefront(const DeviceInfo& device, size_t pixels) {
 
 PathTracer::PathTracer(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const Camera& camera,
                        const RenderSettings& s)
-    : dc_(dc), settings_(s), scene_(dc, scene, bvh) {
+    : dc_(dc), settings_(s), scene_(dc, scene, bvh, s.allFeatures ? SceneFeatures::all() : sceneFeatures(scene)) {
   if (s.width <= 0 || s.height <= 0) throw Error("--width/--height must be positive");
   pixels_ = unsigned(s.width) * unsigned(s.height);
   wavefront_ = s.wavefront ? s.wavefront : defaultWavefront(dc.info, pixels_);
@@ -184,7 +184,8 @@ PathTracer::PathTracer(DeviceContext& dc, const Scene& scene, const Bvh& bvh, co
   // Enough passes in flight that the wavefront stays full while a pass's longest paths
   // finish: pass buffers cost a frame each, so only as many as the wavefront needs.
   passSlots_ = unsigned(std::min<size_t>(FH_MAX_PASS_SLOTS, 2 + (2 * wavefront_ + pixels_ - 1) / pixels_));
-  const std::string options = scene_.caster.traversalOptions() + " -DFH_PASS_SLOTS=" + std::to_string(passSlots_) +
+  const std::string options = scene_.caster.traversalOptions() + scene_.features.buildOptions() +
+                              " -DFH_PASS_SLOTS=" + std::to_string(passSlots_) +
                               " -DFH_METHOD_" +
                               (s.method == Method::PT ? "PT" : s.method == Method::NEE ? "NEE" : "MIS");
   const cl::Program program =
@@ -265,9 +266,10 @@ void PathTracer::enqueueIteration(int current) {
   run(intersect_, wavefront_, "intersect");
 
   setArgs(shade_, params_, queue, nextQueue, finishedQueue_, counters_, rays, nextRays, scene_.caster.triangles(),
-          scene_.triangleMaterial, scene_.materials, scene_.lightPdfArea);
-  setPathArgs(shade_, 11, pathState_);
-  setPathArgs(shade_, cl_uint(11 + pathState_.size()), shadowRequests_);
+          scene_.triangleMaterial, scene_.materials, scene_.lightPdfArea, scene_.normals, scene_.uvs, scene_.texels,
+          scene_.textureInfo);
+  setPathArgs(shade_, 15, pathState_);
+  setPathArgs(shade_, cl_uint(15 + pathState_.size()), shadowRequests_);
   run(shade_, wavefront_, "shade");
 
   if (settings_.method != Method::PT && scene_.lightCount > 0) {

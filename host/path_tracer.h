@@ -39,6 +39,7 @@ struct RenderSettings {
   PixelFilter filter = PixelFilter::Box;
   size_t wavefront = 0;  // paths in flight; 0: chosen for the device
   bool progress = false;
+  bool allFeatures = false;  // compile every material feature, not only the scene's (benchmarks)
 };
 
 // Per pixel: the sum of samples (rgb, w: count) and the sum of their squares.

@@ -46,16 +46,20 @@ FH_INLINE Bsdf material_bsdf(__global const GpuMaterial* m) {
   b.ks = ks;
   const int illum = m->illum;
   const bool has_specular = ks.x > 0.0f || ks.y > 0.0f || ks.z > 0.0f;
+#if defined(FH_GLASS)
   if (illum == 4 || illum == 6 || illum == 7 || illum == 9) {
     b.lobes = FH_LOBE_GLASS;
     b.kd = (float3)(0.0f);
     b.p_specular = 1.0f;
     return b;
   }
+#endif
   b.kd = kd;
   b.lobes = FH_LOBE_DIFFUSE;
+#if defined(FH_GLOSSY)
   if (has_specular && illum >= 2)
     b.lobes |= (illum == 3 || illum == 5 || illum == 8) && ns >= FH_NS_MIRROR ? FH_LOBE_MIRROR : FH_LOBE_GLOSSY;
+#endif
   const float ws = (b.lobes & ~FH_LOBE_DIFFUSE) ? luminance3(ks) : 0.0f;
   const float wd = luminance3(kd) * (1.0f - fmax(fmax(ks.x, ks.y), ks.z));
   b.p_specular = ws + wd > 0.0f ? ws / (ws + wd) : 0.0f;
@@ -63,6 +67,15 @@ FH_INLINE Bsdf material_bsdf(__global const GpuMaterial* m) {
 }
 
 FH_INLINE bool bsdf_has_smooth_lobe(const Bsdf* b) { return (b->lobes & (FH_LOBE_DIFFUSE | FH_LOBE_GLOSSY)) != 0; }
+
+// Scenes are compiled with only the lobes they use (host/device_scene.cpp): FH_GLOSSY
+// for glossy and mirror surfaces, FH_GLASS for dielectrics. Without them the branches
+// below are dead code the compiler removes.
+#if !defined(FH_GLOSSY)
+#define FH_HAS_GLOSSY 0
+#else
+#define FH_HAS_GLOSSY 1
+#endif
 
 // ---- GGX (Trowbridge-Reitz), in the local frame where n = (0, 0, 1) ----
 
@@ -144,7 +157,7 @@ FH_INLINE float diffuse_scale(const Bsdf* b, float cos_o) {
 FH_INLINE float3 bsdf_eval(const Bsdf* b, float3 n, float3 wo, float3 wi) {
   if (dot(n, wi) <= 0.0f || dot(n, wo) <= 0.0f) return (float3)(0.0f);
   float3 f = (b->lobes & FH_LOBE_DIFFUSE) ? b->kd * (M_1_PI_F * diffuse_scale(b, dot(n, wo))) : (float3)(0.0f);
-  if (b->lobes & FH_LOBE_GLOSSY) {
+  if (FH_HAS_GLOSSY && (b->lobes & FH_LOBE_GLOSSY)) {
     const Frame fr = make_frame(n);
     f += ggx_eval(to_local(&fr, wo), to_local(&fr, wi), b->ks, b->alpha);
   }
@@ -155,7 +168,7 @@ FH_INLINE float3 bsdf_eval(const Bsdf* b, float3 n, float3 wo, float3 wi) {
 FH_INLINE float bsdf_pdf(const Bsdf* b, float3 n, float3 wo, float3 wi) {
   if (dot(n, wi) <= 0.0f) return 0.0f;
   float pdf = (b->lobes & FH_LOBE_DIFFUSE) ? (1.0f - b->p_specular) * dot(n, wi) * M_1_PI_F : 0.0f;
-  if (b->lobes & FH_LOBE_GLOSSY) {
+  if (FH_HAS_GLOSSY && (b->lobes & FH_LOBE_GLOSSY)) {
     const Frame fr = make_frame(n);
     pdf += b->p_specular * ggx_pdf(to_local(&fr, wo), to_local(&fr, wi), b->alpha);
   }
@@ -176,34 +189,46 @@ FH_INLINE float fresnel_dielectric(float cos_i, float eta, float* cos_t) {
   return 0.5f * (rs * rs + rp * rp);
 }
 
-// Samples wi given wo (toward the viewer) and ng, the geometric normal (front side).
-// Returns the throughput factor f cos / pdf; *pdf is the density for smooth lobes, or -1
-// for a delta lobe (mirror, glass), which light sampling cannot reach.
-FH_INLINE float3 bsdf_sample(const Bsdf* b, float3 ng, float3 wo, float u0, float u1, float u2, float3* wi,
-                             float* pdf) {
+// Samples wi given wo (toward the viewer), ng (the geometric normal, front side) and ns
+// (the shading normal, on ng's side). Returns the throughput factor f cos / pdf; *pdf is
+// the density for smooth lobes, or -1 for a delta lobe (mirror, glass), which light
+// sampling cannot reach. Directions that a shading normal would send through the
+// geometric surface the wrong way are rejected (factor 0): no light leaks.
+FH_INLINE float3 bsdf_sample(const Bsdf* b, float3 ng, float3 ns, float3 wo, float u0, float u1, float u2,
+                             float3* wi, float* pdf) {
   const bool front = dot(ng, wo) >= 0.0f;
-  const float3 n = front ? ng : -ng;
+  const float3 g = front ? ng : -ng;  // the geometric normal on the viewer's side
+  const float3 n = front ? ns : -ns;
+  *pdf = 0.0f;
+#if defined(FH_GLASS)
   if (b->lobes & FH_LOBE_GLASS) {
     // Entering through the front, leaving through the back: the geometric side decides.
     const float eta = front ? b->eta : 1.0f / b->eta;
     const float cos_i = dot(n, wo);
+    if (cos_i <= 0.0f) return (float3)(0.0f);
     float cos_t;
     const float f = fresnel_dielectric(cos_i, eta, &cos_t);
-    *pdf = -1.0f;
     if (u0 < f) {
       *wi = 2.0f * cos_i * n - wo;
+      if (dot(g, *wi) <= 0.0f) return (float3)(0.0f);
+      *pdf = -1.0f;
       return (float3)(1.0f);
     }
     *wi = normalize(-wo / eta + (cos_i / eta - cos_t) * n);
+    if (dot(g, *wi) >= 0.0f) return (float3)(0.0f);
+    *pdf = -1.0f;
     // Radiance is compressed by (eta_i / eta_t)^2 crossing into the denser medium.
     return b->tf / (eta * eta);
   }
-  if ((b->lobes & FH_LOBE_MIRROR) && u0 < b->p_specular) {
+#endif
+  if (dot(n, wo) <= 0.0f) return (float3)(0.0f);
+  if (FH_HAS_GLOSSY && (b->lobes & FH_LOBE_MIRROR) && u0 < b->p_specular) {
     *wi = 2.0f * dot(n, wo) * n - wo;
+    if (dot(g, *wi) <= 0.0f) return (float3)(0.0f);
     *pdf = -1.0f;
     return fresnel_schlick(b->ks, dot(n, wo)) / b->p_specular;
   }
-  if ((b->lobes & FH_LOBE_GLOSSY) && u0 < b->p_specular) {
+  if (FH_HAS_GLOSSY && (b->lobes & FH_LOBE_GLOSSY) && u0 < b->p_specular) {
     const Frame fr = make_frame(n);
     const float3 lo = to_local(&fr, wo);
     const float3 h = ggx_sample_visible_normal(lo, b->alpha, u1, u2);
@@ -211,9 +236,10 @@ FH_INLINE float3 bsdf_sample(const Bsdf* b, float3 ng, float3 wo, float u0, floa
   } else {
     *wi = sample_cosine_hemisphere(n, u1, u2);
   }
-  *pdf = bsdf_pdf(b, n, wo, *wi);
+  if (dot(g, *wi) <= 0.0f) return (float3)(0.0f);
   // (With a mirror lobe, this is its diffuse part, chosen with 1 - p_specular, which
   // bsdf_pdf includes.)
+  *pdf = bsdf_pdf(b, n, wo, *wi);
   const float3 f = bsdf_eval(b, n, wo, *wi);
   return *pdf > 0.0f ? f * dot(n, *wi) / *pdf : (float3)(0.0f);
 }

@@ -22,7 +22,9 @@
 #define FH_SHADOW_FIELDS(X)                                                                   \
   X(uint, shadow_path, 4)           /* the path slot the contribution goes to */             \
   X(float4, shadow_position, 16)    /* shading point, w: its magnitude (for ray offsets) */  \
-  X(float4, shadow_normal, 16)      /* geometric normal on the viewer's side, w: material */ \
+  X(float4, shadow_normal, 16)      /* shading normal on the viewer's side, w: material */   \
+  X(float4, shadow_geometric, 16)   /* geometric normal on the viewer's side */              \
+  X(float4, shadow_albedo, 16)      /* diffuse albedo there (textures) */                    \
   X(float4, shadow_throughput, 16)  /* throughput before the BSDF sample, w: bounce count */ \
   X(float4, shadow_wo, 16)          /* direction toward the previous vertex */
 

@@ -9,6 +9,7 @@
 #include "path_state.h"
 #include "ray.h"
 #include "rng.h"
+#include "surface.h"
 
 #if !defined(FH_METHOD_PT) && !defined(FH_METHOD_NEE) && !defined(FH_METHOD_MIS)
 #error "build with -DFH_METHOD_PT, -DFH_METHOD_NEE or -DFH_METHOD_MIS"
@@ -39,15 +40,16 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
                     __global uint* finished_queue, volatile __global uint* counters, uint ray_counter,
                     uint next_counter,
                     __global const float4* triangles, __global const int* triangle_material,
-                    __global const GpuMaterial* materials, __global const float* light_pdf_area
-                        FH_PATH_PARAMS FH_SHADOW_PARAMS) {
+                    __global const GpuMaterial* materials, __global const float* light_pdf_area,
+                    __global const float4* normals, __global const float2* uvs, __global const float4* texels,
+                    __global const uint4* texture_info FH_PATH_PARAMS FH_SHADOW_PARAMS) {
   volatile __local uint scratch[2];
   const uint i = get_global_id(0), count = counters[ray_counter];
   bool continues = false, light_sample = false, finishes = false;
   uint p = 0;
   // What a light-sample request needs, kept until its queue position is known.
   float4 request_position = (float4)(0.0f), request_normal = (float4)(0.0f), request_beta = (float4)(0.0f);
-  float3 request_wo = (float3)(0.0f);
+  float3 request_wo = (float3)(0.0f), request_geometric = (float3)(0.0f), request_albedo = (float3)(0.0f);
 
   if (i < count) {
     p = ray_queue[i];
@@ -72,15 +74,26 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
       if (cos_front > 0.0f && (ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f))
         gathered += beta.xyz * ke * emission_weight(bounce, beta.w, light_pdf_area[t], h.x * h.x, cos_front);
 
-      // Two-sided shading for opaque surfaces: the normal on the viewer's side.
-      const float3 n = cos_front >= 0.0f ? s.normal : -s.normal;
+#if defined(FH_SHADING_NORMALS)
+      const float3 ns = shading_normal(normals, t, h.y, h.z, s.normal);
+#else
+      const float3 ns = s.normal;
+#endif
+      // Two-sided shading for opaque surfaces: the normals on the viewer's side.
+      const float3 g = cos_front >= 0.0f ? s.normal : -s.normal;
+      const float3 n = cos_front >= 0.0f ? ns : -ns;
       const bool may_bounce = bounce + 1 <= params.max_depth;
-      const Bsdf bsdf = material_bsdf(m);
+      Bsdf bsdf = material_bsdf(m);
+#if defined(FH_TEXTURES)
+      if (m->texture >= 0) bsdf.kd = texture_lookup(texels, texture_info, m->texture, surface_uv(uvs, t, h.y, h.z));
+#endif
 
 #if !defined(FH_METHOD_PT)
       light_sample = may_bounce && params.light_count > 0 && bsdf_has_smooth_lobe(&bsdf);
       request_position = (float4)(s.position, s.magnitude);
       request_normal = (float4)(n, as_float(material_id));
+      request_geometric = g;
+      request_albedo = bsdf.kd;
       request_beta = (float4)(beta.xyz, as_float(bounce));
       request_wo = wo;
 #endif
@@ -91,7 +104,7 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
         float3 wi;
         float pdf;
         const float3 weight =
-            bsdf_sample(&bsdf, s.normal, wo, random_in_stream(rng, dim + FH_DIM_BSDF_LOBE),
+            bsdf_sample(&bsdf, s.normal, ns, wo, random_in_stream(rng, dim + FH_DIM_BSDF_LOBE),
                         random_in_stream(rng, dim + FH_DIM_BSDF_U1), random_in_stream(rng, dim + FH_DIM_BSDF_U2),
                         &wi, &pdf);
         beta = (float4)(beta.xyz * weight, pdf);
@@ -125,6 +138,8 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
     shadow_normal[request] = request_normal;
     shadow_throughput[request] = request_beta;
     shadow_wo[request] = (float4)(request_wo, 0.0f);
+    shadow_geometric[request] = (float4)(request_geometric, 0.0f);
+    shadow_albedo[request] = (float4)(request_albedo, 0.0f);
   }
   const uint done = group_append(finishes, &counters[FH_COUNT_FINISHED], scratch);
   if (finishes) finished_queue[done] = p;

@@ -28,7 +28,8 @@ __kernel void shadow_connect(RenderParams params, volatile __global uint* counte
   SurfacePoint s;
   s.position = position.xyz;
   s.magnitude = position.w;
-  s.normal = normal.xyz;  // already on the viewer's side
+  s.normal = shadow_geometric[i].xyz;  // the geometric normal on the viewer's side
+  const float3 n = normal.xyz;          // the shading normal, same side
   const float4 beta = shadow_throughput[i];  // w: the bounce count at the shading point
   const uint rng = rng_stream(params.seed, sample_id[p]), dim = (uint)as_int(beta.w) * FH_DIMS_PER_BOUNCE;
 
@@ -41,15 +42,17 @@ __kernel void shadow_connect(RenderParams params, volatile __global uint* counte
   const float dist2 = dot(to_light, to_light);
   if (!(dist2 > 0.0f)) return;
   const float3 wi = to_light * rsqrt(dist2);
-  const float cos_surface = dot(s.normal, wi), cos_light = -dot(l.normal, wi);
-  if (cos_surface <= 0.0f || cos_light <= 0.0f) return;  // behind the surface, or the light's back
+  const float cos_surface = dot(n, wi), cos_light = -dot(l.normal, wi);
+  // Behind the surface (by either normal: no light leaks through), or the light's back.
+  if (cos_surface <= 0.0f || dot(s.normal, wi) <= 0.0f || cos_light <= 0.0f) return;
 
-  const Bsdf bsdf = material_bsdf(materials + as_int(normal.w));
+  Bsdf bsdf = material_bsdf(materials + as_int(normal.w));
+  bsdf.kd = shadow_albedo[i].xyz;  // textured or not, as shade found it
   const float3 wo = shadow_wo[i].xyz;
-  const float3 f = bsdf_eval(&bsdf, s.normal, wo, wi);
+  const float3 f = bsdf_eval(&bsdf, n, wo, wi);
   const float pdf_light = area_to_solid_angle(light_pdf_area[lt], dist2, cos_light);
 #if defined(FH_METHOD_MIS)
-  const float weight = power_heuristic(pdf_light, bsdf_pdf(&bsdf, s.normal, wo, wi));
+  const float weight = power_heuristic(pdf_light, bsdf_pdf(&bsdf, n, wo, wi));
 #else
   const float weight = 1.0f;
 #endif

@@ -23,7 +23,8 @@ __kernel void sample_bsdf(__global const GpuMaterial* m, float4 wo, uint seed, _
   const Bsdf b = material_bsdf(m);
   float3 wi;
   float pdf;
-  const float3 w = bsdf_sample(&b, (float3)(0.0f, 0.0f, 1.0f), wo.xyz, random_float(seed, i, 0),
+  const float3 n = (float3)(0.0f, 0.0f, 1.0f);
+  const float3 w = bsdf_sample(&b, n, n, wo.xyz, random_float(seed, i, 0),
                                random_float(seed, i, 1), random_float(seed, i, 2), &wi, &pdf);
   wi_pdf[i] = (float4)(wi, pdf);
   weight[i] = (float4)(w, 0.0f);
@@ -39,7 +40,8 @@ class BsdfOnDevice : public ::testing::Test {
  protected:
   DeviceContext dc{selectDevices(listDevices(), "").front()};
   cl::Program program = buildProgramFromSource(
-      dc.context, dc.info.device, assembleKernelSources({"bsdf.h", "rng.h"}) + kTestKernels, "");
+      dc.context, dc.info.device, assembleKernelSources({"bsdf.h", "rng.h"}) + kTestKernels,
+      "-DFH_GLOSSY -DFH_GLASS");
 
   static gpu::GpuMaterial material(float kd, float ks, float ns, int illum, float ni = 1.5f, float tf = 1.f) {
     Scene s;

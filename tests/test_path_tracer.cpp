@@ -248,6 +248,26 @@ TEST(PathTracer, MethodsAgreeOnTheCornellBox) {
   EXPECT_LT(vMis, 1.5 * std::min(vPt, vNee));
 }
 
+TEST(PathTracer, SpecializedAndAllFeatureKernelsAgree) {
+  // The Cornell box needs none of the material features; a kernel compiled with all of
+  // them must render the same image (the same samples, up to float rounding in paths).
+  const Scene scene = loadDefaultScene();
+  static DeviceContext dc(selectDevices(listDevices(), "").front());
+  const Bvh bvh = buildBvh(scene);
+  RenderSettings s;
+  s.width = s.height = 16;
+  s.spp = 64;
+  PathTracer specialized(dc, scene, bvh, scene.camera, s);
+  const Film a = specialized.render();
+  s.allFeatures = true;
+  PathTracer everything(dc, scene, bvh, scene.camera, s);
+  const Film b = everything.render();
+  EXPECT_EQ(specialized.stats().bounceRays, everything.stats().bounceRays);
+  double maxDiff = 0;
+  for (size_t i = 0; i < a.sum.size(); ++i) maxDiff = std::max(maxDiff, double(std::fabs(a.sum[i] - b.sum[i])) / std::max(1.0f, std::fabs(a.sum[i])));
+  EXPECT_LT(maxDiff, 1e-3);
+}
+
 TEST(PathTracer, DeterministicForASeedWhateverTheWavefront) {
   const Scene scene = loadDefaultScene();
   const Rendered a = render(scene, scene.camera, Method::MIS, 16, 8, 5, 256);
