@@ -6,7 +6,12 @@
 
 #include <cmath>
 
+#include <OpenImageIO/imageio.h>
+
+#include <array>
+
 #include "device_scene.h"
+#include "image_io.h"
 #include "kernel_sources.h"
 #include "path_tracer.h"
 #include "program.h"
@@ -273,6 +278,60 @@ TEST(WhiteFurnace, LosslessObjectsVanishInAUniformEnclosure) {
       EXPECT_LT(std::fabs(mean - 1.0), 4 * std::sqrt(var) + 2e-3) << name << " " << methodName(method);
     }
   }
+}
+
+// A textured plane under a constant environment: L = rho(uv) * L_env, with rho read from
+// an 8-bit sRGB image (decoded to linear), and v pointing up the image.
+TEST(Textures, AlbedoComesFromTheImageDecodedToLinear) {
+  const std::string dir = test::tempDir("tex");
+  // 8x8 texels: the top half (v > 0.5) one colour, the bottom half another.
+  const unsigned char top[3] = {200, 60, 20}, bottom[3] = {40, 120, 220};
+  std::vector<unsigned char> pixels;
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) {
+      const unsigned char* c = y < 4 ? top : bottom;
+      pixels.insert(pixels.end(), c, c + 3);
+    }
+  {
+    auto out = OIIO::ImageOutput::create(dir + "/t.png");
+    ASSERT_TRUE(out);
+    ASSERT_TRUE(out->open(dir + "/t.png", OIIO::ImageSpec(8, 8, 3, OIIO::TypeDesc::UINT8)));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
+    out->close();
+  }
+  test::SceneBuilder b;
+  const int m = b.material(0.5f);
+  b.quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, m);  // faces +y
+  Scene scene = b.build();
+  scene.materials[size_t(m)].kdTexture = 0;
+  scene.textures.push_back({dir + "/t.png"});
+  // Corners in quad order: (-1,-1) (-1,1) (1,1) (1,-1) in (x, z); v runs toward -z.
+  const float uv[4][2] = {{0.05f, 0.95f}, {0.05f, 0.05f}, {0.95f, 0.05f}, {0.95f, 0.95f}};
+  for (int tri : {0, 1})
+    for (int k : tri == 0 ? std::array<int, 3>{0, 1, 2} : std::array<int, 3>{0, 2, 3})
+      scene.cornerUVs.insert(scene.cornerUVs.end(), {uv[k][0], uv[k][1]});
+  Camera camera;
+  camera.eye = {0, 3, 0.001f};
+  camera.target = {0, 0, 0};
+  camera.up = {0, 0, -1};  // image up = -z = toward v = 1
+  camera.fovYDeg = 20.f;
+  DeviceContext dc(selectDevices(listDevices(), "").front());
+  const Bvh bvh = buildBvh(scene);
+  RenderSettings s;
+  s.width = s.height = 8;
+  s.spp = 16;
+  s.method = Method::PT;
+  s.env = {1.f, 1.f, 1.f};
+  PathTracer tracer(dc, scene, bvh, camera, s);
+  const Image img = tracer.render().image();
+  // The camera sees only the plane; rows 0-2 lie in the texture's top half, 5-7 in the bottom.
+  for (int y : {0, 1, 2, 5, 6, 7})
+    for (int x = 0; x < 8; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const float expected = srgbToLinear((y < 4 ? top : bottom)[c] / 255.f);
+        EXPECT_NEAR(img.rgb[size_t(3 * (y * 8 + x) + c)], expected, 0.02f + 0.05f * expected)
+            << "pixel " << x << "," << y << " channel " << c;
+      }
 }
 
 }  // namespace
