@@ -14,6 +14,7 @@
 #include "error.h"
 #include "image_io.h"
 #include "device_scene.h"
+#include "error_metrics.h"
 #include "multi_device.h"
 #include "path_tracer.h"
 #include "render_aov.h"
@@ -245,6 +246,11 @@ int main(int argc, char** argv) {
   bench.external = makeEmbreeTracer;
 #endif
 
+  std::string compareImage, compareReference;
+  auto* comparing = app.add_subcommand("compare", "Error of an image against a reference (relMSE, RMSE, MAE) as JSON");
+  comparing->add_option("image", compareImage, "Rendered image (.exr .hdr .pfm ...)")->required();
+  comparing->add_option("reference", compareReference, "Reference image of the same size")->required();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -254,6 +260,13 @@ int main(int argc, char** argv) {
     if (*devices) return runDevices(devicesSpec);
     if (*rendering) return runRender(render);
     if (*benching) return runBench(bench);
+    if (*comparing) {
+      for (const std::string* path : {&compareImage, &compareReference})
+        if (!std::filesystem::is_regular_file(*path)) throw Error(*path + ": image not found");
+      const ImageError e = imageError(readImage(compareImage), readImage(compareReference));
+      std::cout << "{\"relmse\": " << e.relMse << ", \"rmse\": " << e.rmse << ", \"mae\": " << e.mae << "}\n";
+      return 0;
+    }
   } catch (const BuildError& e) {
     std::cerr << "fredholm: error: " << e.what() << "\n";
     return 1;
