@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "error.h"
+#include "error_metrics.h"
 #include "image_io.h"
 #include "test_support.h"
 
@@ -103,6 +104,29 @@ TEST(ImageIoCli, DefaultNameStepsAside) {
   EXPECT_NE(second.output.find("wrote fredholm-1.png"), std::string::npos) << second.output;
   EXPECT_TRUE(std::filesystem::exists(dir + "/fredholm.png"));
   EXPECT_TRUE(std::filesystem::exists(dir + "/fredholm-1.png"));
+}
+
+}  // namespace
+}  // namespace fh
+
+namespace fh {
+namespace {
+
+TEST(ErrorMetrics, KnownValues) {
+  Image ref, img;
+  ref.width = img.width = 2;
+  ref.height = img.height = 1;
+  ref.rgb = {1.f, 1.f, 1.f, 0.f, 0.f, 0.f};
+  img.rgb = {1.5f, 1.f, 1.f, 0.1f, 0.f, 0.f};
+  const ImageError e = imageError(img, ref);
+  // relMSE: (0.25 / 1.01 + 0.01 / 0.01) / 6; RMSE: sqrt(0.26 / 6); MAE: 0.6 / 6.
+  EXPECT_NEAR(e.relMse, (0.25 / 1.01 + 1.0) / 6.0, 1e-6);
+  EXPECT_NEAR(e.rmse, std::sqrt(0.26 / 6.0), 1e-6);
+  EXPECT_NEAR(e.mae, 0.1, 1e-6);
+  EXPECT_EQ(imageError(ref, ref).relMse, 0.0);
+  Image small = ref;
+  small.width = 1;
+  EXPECT_THROW(imageError(small, ref), Error);
 }
 
 }  // namespace
