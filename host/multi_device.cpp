@@ -2,6 +2,7 @@
 #include "multi_device.h"
 
 #include <chrono>
+#include <condition_variable>
 #include <cstdlib>
 #include <deque>
 #include <map>
@@ -23,15 +24,25 @@ class PassPool {
       : total_(passes), pixels_(pixels), settings_(s), outstanding_(size_t(devices)), done_(size_t(devices), 0),
         sum_(pixels * 4, 0.0), sumSq_(pixels * 4, 0.0), progress_(s.progress), start_(Clock::now()) {}
 
+  // The next pass for `device`. When none is left but other devices still have passes in
+  // flight, a device with none of its own waits: if one of them fails, its passes come
+  // back here and must find a device still running. (A device with passes of its own
+  // never waits; it asks again after its next batch.)
   bool take(int device, uint32_t& pass) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!requeued_.empty()) {
-      pass = requeued_.front();
-      requeued_.pop_front();
-    } else {
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+      if (!requeued_.empty()) {
+        pass = requeued_.front();
+        requeued_.pop_front();
+        break;
+      }
       const double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
-      if (next_ >= total_ || (settings_.seconds > 0.0 && elapsed >= settings_.seconds)) return false;
-      pass = next_++;
+      if (next_ < total_ && !(settings_.seconds > 0.0 && elapsed >= settings_.seconds)) {
+        pass = next_++;
+        break;
+      }
+      if (!outstanding_[size_t(device)].empty() || !anyOutstanding()) return false;
+      changed_.wait(lock);
     }
     outstanding_[size_t(device)].insert(pass);
     return true;
@@ -40,6 +51,7 @@ class PassPool {
   void done(int device, uint32_t pass, std::vector<float>& samples) {
     std::lock_guard<std::mutex> lock(mutex_);
     outstanding_[size_t(device)].erase(pass);
+    changed_.notify_all();
     ++done_[size_t(device)];
     pending_[pass].swap(samples);
     mergeInOrder();
@@ -53,6 +65,7 @@ class PassPool {
     std::lock_guard<std::mutex> lock(mutex_);
     for (uint32_t pass : outstanding_[size_t(device)]) requeued_.push_back(pass);
     outstanding_[size_t(device)].clear();
+    changed_.notify_all();
   }
 
   uint64_t passesDone(int device) const { return done_[size_t(device)]; }
@@ -87,6 +100,12 @@ class PassPool {
     ++merged_;
   }
 
+  bool anyOutstanding() const {
+    for (const auto& o : outstanding_)
+      if (!o.empty()) return true;
+    return false;
+  }
+
   void mergeInOrder() {
     for (auto it = pending_.find(nextToMerge_); it != pending_.end(); it = pending_.find(nextToMerge_)) {
       add(it->second);
@@ -96,6 +115,7 @@ class PassPool {
   }
 
   std::mutex mutex_;
+  std::condition_variable changed_;  // passes finished, or came back from a failed device
   const uint32_t total_;
   const size_t pixels_;
   const RenderSettings settings_;
