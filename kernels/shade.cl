@@ -69,7 +69,9 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
       const float3 wo = -dir;
       const float cos_front = dot(s.normal, wo);
 
-      // Emission leaves the front (counter-clockwise) side only.
+      // Emission leaves the front (counter-clockwise) side only. The MIS weight measures
+      // the light's density from the ray's origin, the offset point shadow_connect also
+      // connects from, so the two strategies weigh the same paths.
       const float3 ke = vload3(0, m->ke);
       if (cos_front > 0.0f && (ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f))
         gathered += beta.xyz * ke * emission_weight(bounce, beta.w, light_pdf_area[t], h.x * h.x, cos_front);

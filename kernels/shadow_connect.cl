@@ -38,7 +38,11 @@ __kernel void shadow_connect(RenderParams params, volatile __global uint* counte
   const float2 b = sample_triangle(random_in_stream(rng, dim + FH_DIM_LIGHT_U1),
                                    random_in_stream(rng, dim + FH_DIM_LIGHT_U2));
   const SurfacePoint l = surface_point(triangles, lt, b.x, b.y);
-  const float3 to_light = l.position - s.position;
+  // Connect from the point just off the surface that BSDF-sampled rays also start from:
+  // both strategies then see the same geometry, and their MIS weights sum to one even
+  // where the offset is a visible distance (far from the origin).
+  const float3 origin = offset_ray_origin(&s, s.normal);
+  const float3 to_light = l.position - origin;
   const float dist2 = dot(to_light, to_light);
   if (!(dist2 > 0.0f)) return;
   const float3 wi = to_light * rsqrt(dist2);
@@ -61,7 +65,6 @@ __kernel void shadow_connect(RenderParams params, volatile __global uint* counte
   if (!(contribution.x > 0.0f || contribution.y > 0.0f || contribution.z > 0.0f)) return;
 
   // V(x, y): the segment from just off the surface to just short of the light point.
-  const float3 origin = offset_ray_origin(&s, wi);
   const float3 target = offset_ray_origin(&l, -wi);
   const float3 d = target - origin;
   const float dist = length(d);

@@ -34,7 +34,7 @@ struct Rendered {
 };
 
 Rendered render(const Scene& scene, const Camera& camera, Method method, int size, int spp, unsigned seed = 1,
-                size_t wavefront = 0, std::array<float, 3> env = {0, 0, 0}) {
+                size_t wavefront = 0, std::array<float, 3> env = {0, 0, 0}, int maxDepth = 64) {
   static DeviceContext dc(selectDevices(listDevices(), "").front());
   const Bvh bvh = buildBvh(scene);
   RenderSettings s;
@@ -44,6 +44,7 @@ Rendered render(const Scene& scene, const Camera& camera, Method method, int siz
   s.seed = seed;
   s.wavefront = wavefront;
   s.env = env;
+  s.maxDepth = maxDepth;
   PathTracer tracer(dc, scene, bvh, camera, s);
   Rendered r{tracer.render(), tracer.stats()};
   return r;
@@ -309,6 +310,134 @@ TEST(PathTracer, StatsCountRaysAndSamples) {
   for (const char* key : {"samples", "seconds", "samples_per_second", "nonfinite_samples", "devices"})
     EXPECT_TRUE(json.contains(key)) << key;
   EXPECT_EQ(json["devices"][0]["samples"], r.stats.samples);
+}
+
+// ---- Scenes built to break one method each: stable (finite), and converging where the
+// answer is known. "mis is never much worse than the better of pt and nee" is tested as
+// its image variance at equal samples within 1.5x of the better one's (equal time is too
+// noisy a measure inside a test; bench/converge.py measures it).
+
+Scene furnaceAt(float rho, float le, float scale, const float3& offset) {
+  SceneBuilder b;
+  b.closedBoxInside(float3{-1, -1, -1} * scale + offset, float3{1, 1, 1} * scale + offset, b.material(rho, le));
+  return b.build();
+}
+
+TEST(WhereMethodsFail, ExtremeScalesAndFarFromTheOrigin) {
+  for (const auto& [scale, offset] : {std::pair{1e-3f, float3{0, 0, 0}}, {1e4f, float3{0, 0, 0}},
+                                      {1.f, float3{1e4f, -2e4f, 3e4f}}, {1e-3f, float3{10, 20, -30}}}) {
+    const Scene scene = furnaceAt(0.5f, 1.f, scale, offset);
+    Camera c = insideCamera();
+    c.eye = c.eye * scale + offset;
+    c.target = c.target * scale + offset;
+    for (Method m : {Method::PT, Method::NEE, Method::MIS}) {
+      const Rendered r = render(scene, c, m, 16, 128);
+      EXPECT_EQ(r.stats.nonfinite, 0u);
+      expectMatches(r.film, [](size_t) { return 2.0; },
+                    std::string(methodName(m)) + " at scale " + std::to_string(scale) + " offset " +
+                        std::to_string(offset[0]));
+    }
+  }
+}
+
+TEST(WhereMethodsFail, AlbedoNearOneRouletteStaysUnbiasedAndEnds) {
+  // rho = 0.95: L = Le / (1 - rho) = 20, paths of ~20 bounces; the depth limit is raised so
+  // only Russian roulette ends them (0.95^1001 is far below the noise).
+  const Scene scene = furnaceAt(0.95f, 1.f, 1.f, {0, 0, 0});
+  for (Method m : {Method::PT, Method::MIS}) {
+    const Rendered r = render(scene, insideCamera(), m, 16, 256, 1, 0, {0, 0, 0}, 1000);
+    EXPECT_EQ(r.stats.nonfinite, 0u);
+    expectMatches(r.film, [](size_t) { return 20.0; }, methodName(m));
+  }
+}
+
+TEST(WhereMethodsFail, DegenerateTrianglesAndZeroAreaEmittersChangeNothing) {
+  SceneBuilder b;
+  b.closedBoxInside({-1, -1, -1}, {1, 1, 1}, b.material(0.5f, 1.f));
+  // Zero-area triangles (one a would-be emitter) floating inside the box.
+  const int bright = b.material(0.5f, 100.f);
+  b.quad({0.2f, 0.2f, 0.2f}, {0.2f, 0.2f, 0.2f}, {0.2f, 0.2f, 0.2f}, {0.2f, 0.2f, 0.2f}, bright);
+  b.quad({-0.3f, 0.f, 0.f}, {0.3f, 0.f, 0.f}, {0.6f, 0.f, 0.f}, {0.9f, 0.f, 0.f}, bright);  // collinear
+  const Scene scene = b.build();
+  EXPECT_EQ(scene.lights.size(), 12u);  // the zero-area emitters are left out of the light list
+  for (Method m : {Method::PT, Method::NEE, Method::MIS}) {
+    const Rendered r = render(scene, insideCamera(), m, 16, 128);
+    EXPECT_EQ(r.stats.nonfinite, 0u);
+    expectMatches(r.film, [](size_t) { return 2.0; }, methodName(m));
+  }
+}
+
+TEST(WhereMethodsFail, NoLightsIsBlackAndCameraInsideAnObjectIsFinite) {
+  SceneBuilder dark;
+  dark.closedBoxInside({-1, -1, -1}, {1, 1, 1}, dark.material(0.8f));
+  for (Method m : {Method::PT, Method::NEE, Method::MIS}) {
+    const Rendered r = render(dark.build(), insideCamera(), m, 8, 8);
+    for (float v : r.film.sum) EXPECT_EQ(v == 0.f || v == 8.f, true);  // radiance 0, counts 8
+  }
+  // The camera inside a closed box whose faces point outward: it sees only back faces.
+  SceneBuilder inverted;
+  const int m = inverted.material(0.7f, 0.5f);
+  inverted.quadFacing({-1, -1, -1}, {1, -1, -1}, {1, -1, 1}, {-1, -1, 1}, {0, -5, 0}, m);
+  inverted.quadFacing({-1, 1, -1}, {-1, 1, 1}, {1, 1, 1}, {1, 1, -1}, {0, 5, 0}, m);
+  inverted.quadFacing({-1, -1, -1}, {-1, -1, 1}, {-1, 1, 1}, {-1, 1, -1}, {-5, 0, 0}, m);
+  inverted.quadFacing({1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}, {5, 0, 0}, m);
+  inverted.quadFacing({-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}, {1, -1, -1}, {0, 0, -5}, m);
+  inverted.quadFacing({-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}, {0, 0, 5}, m);
+  for (Method method : {Method::PT, Method::NEE, Method::MIS}) {
+    const Rendered r = render(inverted.build(), insideCamera(), method, 8, 16);
+    EXPECT_EQ(r.stats.nonfinite, 0u);
+    // Emission leaves the fronts only (outward): inside, nothing is lit.
+    for (float v : r.film.image().rgb) EXPECT_EQ(v, 0.f);
+  }
+}
+
+// A tiny, bright light over a plane (Lambert's formula again): BRDF sampling almost never
+// finds it, so pt is far noisier; mis must stay within 1.5x of nee's variance.
+TEST(WhereMethodsFail, TinyBrightLight) {
+  SceneBuilder b;
+  const float rho = 0.5f, h = 1.f, half = 0.02f, le = 0.25f / (4 * half * half);  // power of a 0.5-wide quad at Le 0.25
+  b.quad({-5, 0, -5}, {-5, 0, 5}, {5, 0, 5}, {5, 0, -5}, b.material(rho));
+  const std::vector<float3> light = {{-half, h, -half}, {half, h, -half}, {half, h, half}, {-half, h, half}};
+  b.quad(light[0], light[1], light[2], light[3], b.material(0.f, le));
+  const Scene scene = b.build();
+  Camera camera;
+  camera.eye = {0.f, 0.5f, 2.5f};
+  camera.target = {0.f, 0.f, 0.f};
+  camera.fovYDeg = 50.f;
+  const int size = 16;
+  const Rendered pt = render(scene, camera, Method::PT, size, 256, 21);
+  const Rendered nee = render(scene, camera, Method::NEE, size, 256, 22);
+  const Rendered mis = render(scene, camera, Method::MIS, size, 256, 23);
+  for (const Rendered* r : {&pt, &nee, &mis}) EXPECT_EQ(r->stats.nonfinite, 0u);
+  // nee and mis converge to Lambert's value on the plane (the light itself is too small
+  // to cover a pixel, and pixels that see it or the plane's edge are skipped).
+  const CameraFrame f = makeCameraFrame(camera, size, size);
+  auto expected = [&](size_t p) {
+    double sum = 0;
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i) {
+        const float3 d = normalize(cameraRayDirection(f, float(p % size) + (i + 0.5f) / 4,
+                                                      float(p / size) + (j + 0.5f) / 4, size, size));
+        if (d[1] >= 0.f) return double(NAN);
+        const float3 x = camera.eye + d * (-camera.eye[1] / d[1]);
+        if (std::fabs(x[0]) > 5.f || std::fabs(x[2]) > 5.f) return double(NAN);
+        sum += rho / M_PI * lambertIrradiance(x, {0, 1, 0}, light, le);
+      }
+    return sum / 16;
+  };
+  expectMatches(nee.film, expected, "nee");
+  expectMatches(mis.film, expected, "mis");
+  // Squared error against the exact image (pt's own variance estimate is useless here: most
+  // of its pixels never saw the light, so their sample variance is zero).
+  auto squaredError = [&](const Film& film) {
+    double e = 0;
+    for (size_t p = 0; p < size_t(size) * size; ++p)
+      if (!std::isnan(expected(p))) e += std::pow(luminanceMean(film, p) - expected(p), 2);
+    return e;
+  };
+  const double ePt = squaredError(pt.film), eNee = squaredError(nee.film), eMis = squaredError(mis.film);
+  EXPECT_LT(eMis, 1.5 * std::min(ePt, eNee)) << "pt " << ePt << " nee " << eNee << " mis " << eMis;
+  EXPECT_GT(ePt, 10 * eNee) << "pt " << ePt << " nee " << eNee;  // the failure this scene is for
 }
 
 }  // namespace
