@@ -32,7 +32,7 @@ __kernel void accumulate_paths(__global const uint* finished_queue, volatile __g
 
 // Closes an iteration's books (a single work-item): the freed slots join the free list,
 // and the ray totals grow.
-inline void add_64(volatile __global uint* pair, uint value) {
+FH_INLINE void add_64(volatile __global uint* pair, uint value) {
   const uint low = pair[0] + value;
   pair[1] += low < value;  // carry
   pair[0] = low;
