@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 
 #include <chrono>
+#include <optional>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -19,6 +20,7 @@
 #include "path_tracer.h"
 #include "render_aov.h"
 #include "scene_loader.h"
+#include "vec.h"
 #ifdef FREDHOLM_HAVE_EMBREE
 #include "embree_tracer.h"
 #endif
@@ -39,7 +41,7 @@ struct RenderOptions {
   bool allFeatures = false;
   unsigned seed = 1;
   std::string cameraFile, eye, target, up;
-  float fov = 0.f;
+  std::optional<float> fov;
   std::string aov;
   std::string device;
 };
@@ -51,6 +53,7 @@ void printWarnings(const Scene& scene) {
 // --camera FILE, else the scene's sidecar, else framing; then --eye/--target/--up/--fov override.
 Camera chooseCamera(const RenderOptions& o, const Scene& scene) {
   Camera camera;
+  bool framed = false;
   if (!o.cameraFile.empty()) {
     camera = loadCameraJson(o.cameraFile);
   } else if (scene.hasCamera) {
@@ -59,6 +62,7 @@ Camera chooseCamera(const RenderOptions& o, const Scene& scene) {
     Vec3f lo, hi;
     scene.bounds(lo, hi);
     camera = frameBounds(lo, hi);
+    framed = true;
     if (o.eye.empty() || o.target.empty())
       std::cerr << "fredholm: no camera given (--camera, --eye/--target, or a .camera.json beside the OBJ): "
                    "framing the scene's bounds\n";
@@ -66,8 +70,11 @@ Camera chooseCamera(const RenderOptions& o, const Scene& scene) {
   if (!o.eye.empty()) camera.eye = parseVec3Flag("--eye", o.eye);
   if (!o.target.empty()) camera.target = parseVec3Flag("--target", o.target);
   if (!o.up.empty()) camera.up = parseVec3Flag("--up", o.up);
-  if (o.fov != 0.f) camera.fovYDeg = o.fov;
-  validateCamera(camera, "camera");
+  if (o.fov) camera.fovYDeg = *o.fov;
+  if (framed && (!isFinite(camera.eye) || !isFinite(camera.target)))
+    throw Error(scene.sourcePath + ": the scene's bounds are too large to frame a camera; give --camera or "
+                                   "--eye/--target");
+  validateCamera(camera, o.fov ? "--fov" : "camera");
   return camera;
 }
 
@@ -92,6 +99,10 @@ int runRender(RenderOptions o) {
   settings.filter = parseFilter(o.filter);
   if (!o.env.empty()) settings.env = parseVec3Flag("--env", o.env);
   if (o.width <= 0 || o.height <= 0) throw Error("--width/--height must be positive");
+  // Pixels are indexed in 32 bits on the device, with room for several pass buffers.
+  if (uint64_t(o.width) * uint64_t(o.height) > (uint64_t(1) << 28))
+    throw Error("--width/--height: " + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                " is more than the 268 million pixels fredholm renders in one image");
   if (o.spp < 0) throw Error("--spp must be positive");
   if (o.seconds < 0) throw Error("--time must be positive");
   if (o.maxDepth < 1) throw Error("--max-depth must be at least 1");

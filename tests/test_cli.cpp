@@ -22,6 +22,8 @@ TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
       {"--eye 0,1", "--eye '0,1': expected three comma-separated numbers"},
       {"--width 0", "--width/--height must be positive"},
       {"--max-depth 0", "--max-depth must be at least 1"},
+      {"--fov 0", "--fov: vertical field of view must lie in (0, 180) degrees"},
+      {"--width 100000 --height 100000", "is more than the 268 million pixels"},
       {"--camera /nonexistent/cam.json", "cannot open camera file"},
       {"/nonexistent/scene.obj", "/nonexistent/scene.obj: OBJ file not found"},
   };
