@@ -59,7 +59,7 @@ def main():
     p.add_argument("--methods", default="pt,nee,mis")
     args = p.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
-    name = os.path.splitext(os.path.basename(args.scene))[0] if args.scene else "cornell-box"
+    name = os.path.splitext(os.path.basename(args.scene))[0].replace(":", "-") if args.scene else "cornell-box"
 
     reference = args.ref
     if not reference:

@@ -14,6 +14,7 @@
 #include "devices.h"
 #include "error.h"
 #include "image_io.h"
+#include "closed_form.h"
 #include "device_scene.h"
 #include "error_metrics.h"
 #include "multi_device.h"
@@ -122,7 +123,9 @@ int runRender(RenderOptions o) {
 
   const auto devices = selectDevices(listDevices(), o.device);
 
-  const Scene scene = o.scene.empty() ? loadDefaultScene() : loadScene(o.scene);
+  const Scene scene = o.scene.empty()          ? loadDefaultScene()
+                      : isBuiltinSpec(o.scene) ? builtinScene(o.scene)
+                                               : loadScene(o.scene);
   printWarnings(scene);
   const Camera camera = chooseCamera(o, scene);
   const auto start = std::chrono::steady_clock::now();
@@ -262,6 +265,16 @@ int main(int argc, char** argv) {
   comparing->add_option("image", compareImage, "Rendered image (.exr .hdr .pfm ...)")->required();
   comparing->add_option("reference", compareReference, "Reference image of the same size")->required();
 
+  std::string referenceScene, referenceOutput;
+  int referenceWidth = 128, referenceHeight = 128;
+  bool referenceForce = false;
+  auto* referencing = app.add_subcommand("reference", "Write the exact image of a closed-form scene (builtin:NAME)");
+  referencing->add_option("scene", referenceScene, "builtin:plane-under-light")->required();
+  referencing->add_option("-o,--output", referenceOutput, "Output image")->required();
+  referencing->add_option("--width", referenceWidth, "Image width")->capture_default_str();
+  referencing->add_option("--height", referenceHeight, "Image height")->capture_default_str();
+  referencing->add_flag("--force", referenceForce, "Overwrite an existing output file");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -271,6 +284,14 @@ int main(int argc, char** argv) {
     if (*devices) return runDevices(devicesSpec);
     if (*rendering) return runRender(render);
     if (*benching) return runBench(bench);
+    if (*referencing) {
+      checkOutputPath(referenceOutput, referenceForce);
+      if (referenceWidth <= 0 || referenceHeight <= 0) throw Error("--width/--height must be positive");
+      writeImage(referenceOutput, builtinReference(referenceScene, referenceWidth, referenceHeight),
+                 {{"scene", referenceScene}, {"method", "exact"}});
+      std::cout << "wrote " << referenceOutput << "\n";
+      return 0;
+    }
     if (*comparing) {
       for (const std::string* path : {&compareImage, &compareReference})
         if (!std::filesystem::is_regular_file(*path)) throw Error(*path + ": image not found");

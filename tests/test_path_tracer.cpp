@@ -12,6 +12,7 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 
+#include "closed_form.h"
 #include "path_tracer.h"
 #include "scene_builder.h"
 #include "test_support.h"
@@ -129,62 +130,15 @@ TEST_P(EveryMethod, ClosedFurnaceBoxIsLeOverOneMinusRho) {
   }
 }
 
-// Irradiance at x (normal n) from a uniformly emitting polygon of radiance le:
-// E = (le / 2) |sum_k Theta_k (n . Gamma_k)| (Lambert; the polygon wholly in front of x).
-double lambertIrradiance(const float3& x, const float3& n, const std::vector<float3>& polygon, double le) {
-  double sum = 0;
-  for (size_t k = 0; k < polygon.size(); ++k) {
-    const float3 a = normalize(polygon[k] - x), b = normalize(polygon[(k + 1) % polygon.size()] - x);
-    const double theta = std::acos(std::clamp(double(dot(a, b)), -1.0, 1.0));
-    sum += theta * dot(normalize(cross(a, b)), n);
-  }
-  return 0.5 * le * std::fabs(sum);
-}
-
 TEST_P(EveryMethod, PlaneUnderRectangularEmitterFollowsLambertsFormula) {
-  SceneBuilder b;
-  const float rho = 0.5f, le = 4.f, h = 1.f;
-  b.quad({-5, 0, -5}, {-5, 0, 5}, {5, 0, 5}, {5, 0, -5}, b.material(rho));  // faces +y
-  const std::vector<float3> light = {{-0.5f, h, -0.5f}, {0.5f, h, -0.5f}, {0.5f, h, 0.5f}, {-0.5f, h, 0.5f}};
-  b.quad(light[0], light[1], light[2], light[3], b.material(0.f, le));  // faces -y, toward the plane
-  const Scene scene = b.build();
-  Camera camera;
-  camera.eye = {0.f, 0.6f, 2.5f};  // below the emitter, which it sees from the front
-  camera.target = {0.f, 0.f, 0.f};
-  camera.fovYDeg = 60.f;
+  const Scene scene = PlaneUnderLight::scene();
   const int size = 24;
-  const Rendered r = render(scene, camera, GetParam(), size, 256);
+  const Rendered r = render(scene, scene.camera, GetParam(), size, 256);
   EXPECT_EQ(r.stats.nonfinite, 0u);
-
-  // The exact pixel value: the box filter's average over the pixel, integrated on an 8x8
-  // grid; pixels whose footprint sees more than one surface (edges) are skipped.
-  const CameraFrame f = makeCameraFrame(camera, size, size);
-  auto radianceAlong = [&](const float3& d, int& surface) -> double {
-    const double org[3] = {camera.eye[0], camera.eye[1], camera.eye[2]}, dir[3] = {d[0], d[1], d[2]};
-    const test::BruteHit hit = test::bruteForceClosest(scene, org, dir);
-    surface = hit.triangle < 0 ? -1 : scene.triangleMaterial[size_t(hit.triangle)];
-    if (surface < 0) return 0.0;
-    if (surface == 1) return dot(d, {0, 1, 0}) > 0 ? le : 0.0;  // the emitter's front faces down
-    const float3 x = camera.eye + d * float(hit.t);
-    return rho / M_PI * lambertIrradiance(x, {0, 1, 0}, light, le);
-  };
-  std::vector<double> expected(size_t(size) * size);
-  for (int y = 0; y < size; ++y)
-    for (int x = 0; x < size; ++x) {
-      double sum = 0;
-      int first = -2;
-      bool mixed = false;
-      for (int j = 0; j < 8; ++j)
-        for (int i = 0; i < 8; ++i) {
-          int surface;
-          sum += radianceAlong(normalize(cameraRayDirection(f, x + (i + 0.5f) / 8, y + (j + 0.5f) / 8, size, size)),
-                               surface);
-          mixed |= first != -2 && surface != first;
-          first = surface;
-        }
-      expected[size_t(y * size + x)] = mixed ? NAN : sum / 64;
-    }
-  expectMatches(r.film, [&](size_t p) { return expected[p]; }, methodName(GetParam()));
+  // The exact pixel values (box filter, 8x8 grid per pixel); pixels whose footprint sees
+  // more than one surface are skipped.
+  const Image exact = PlaneUnderLight::reference(scene.camera, size, size, 8, true);
+  expectMatches(r.film, [&](size_t p) { return double(exact.rgb[3 * p]); }, methodName(GetParam()));
 }
 
 TEST_P(EveryMethod, PlaneUnderConstantEnvironmentIsRhoTimesEnv) {
