@@ -3,6 +3,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -83,6 +84,25 @@ TEST(RenderCli, ProgressLinesWhenNotATerminal) {
   EXPECT_NE(r.output.find("fredholm: 100%"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("Msamples/s"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find('\r'), std::string::npos);  // no redrawn bar in a log
+}
+
+TEST(ReferenceCli, ExactImageOfTheClosedFormSceneAndItsErrors) {
+  const std::string dir = test::tempDir("cli");
+  const auto ok = test::runFredholm("reference builtin:plane-under-light --width 8 --height 6 -o " + dir + "/e.exr");
+  ASSERT_EQ(ok.exitCode, 0) << ok.output;
+  const Image exact = readImage(dir + "/e.exr");
+  EXPECT_EQ(exact.width, 8);
+  EXPECT_EQ(exact.height, 6);
+  for (float v : exact.rgb) EXPECT_TRUE(std::isfinite(v) && v >= 0.f);
+  const auto again = test::runFredholm("reference builtin:plane-under-light -o " + dir + "/e.exr");
+  EXPECT_EQ(again.exitCode, 1);
+  EXPECT_NE(again.output.find("file exists"), std::string::npos) << again.output;
+  const auto unknown = test::runFredholm("reference builtin:nothing -o " + dir + "/n.exr");
+  EXPECT_EQ(unknown.exitCode, 1);
+  EXPECT_NE(unknown.output.find("'builtin:nothing': unknown built-in scene"), std::string::npos) << unknown.output;
+  const auto rendered = test::runFredholm("render builtin:plane-under-light --width 8 --height 6 --spp 4 -o " + dir +
+                                          "/r.exr");
+  EXPECT_EQ(rendered.exitCode, 0) << rendered.output;
 }
 
 }  // namespace
