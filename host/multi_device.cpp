@@ -1,6 +1,7 @@
 // Several devices, one render: a shared pass pool and an in-order merge.
 #include "multi_device.h"
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <cstdlib>
@@ -168,25 +169,45 @@ MultiDeviceResult renderOnDevices(const std::vector<DeviceInfo>& devices, const 
   std::vector<RenderStats> perDevice(devices.size());
   const auto start = Clock::now();
 
+  // Every device builds its program and uploads the scene first; the passes are handed out
+  // once all are ready (or failed), so a device that compiles slowly is not left without
+  // work by one that compiled fast.
+  std::mutex readyMutex;
+  std::condition_variable readyChanged;
+  size_t settled = 0;
+  auto settle = [&] {
+    std::unique_lock<std::mutex> lock(readyMutex);
+    ++settled;
+    readyChanged.notify_all();
+    readyChanged.wait(lock, [&] { return settled == devices.size(); });
+  };
+
+  std::vector<Clock::time_point> ends(devices.size());
   std::vector<std::thread> threads;
   for (size_t i = 0; i < devices.size(); ++i) {
     threads.emplace_back([&, i] {
       auto& share = result.stats.devices[i];
       share.name = devices[i].name;
-      const auto begin = Clock::now();
+      bool settledHere = false;
+      auto begin = Clock::now();
       try {
         DeviceContext dc(devices[i]);
         RenderSettings s = settings;
         s.progress = false;
         PathTracer tracer(dc, scene, bvh, camera, s);
+        settledHere = true;
+        settle();
+        begin = Clock::now();
         DeviceSource source(pool, int(i), simulatedFailure(int(i)));
         tracer.renderPasses(source);
         perDevice[i] = tracer.stats();
       } catch (const std::exception& e) {
         share.error = e.what();
         pool.fail(int(i));
+        if (!settledHere) settle();
       }
-      share.busySeconds = std::chrono::duration<double>(Clock::now() - begin).count();
+      ends[i] = Clock::now();
+      share.busySeconds = std::chrono::duration<double>(ends[i] - begin).count();
     });
   }
   for (auto& t : threads) t.join();
@@ -200,7 +221,8 @@ MultiDeviceResult renderOnDevices(const std::vector<DeviceInfo>& devices, const 
   for (size_t i = 0; i < devices.size(); ++i) {
     auto& share = st.devices[i];
     share.samples = pool.passesDone(int(i)) * pixels;
-    share.idleSeconds = std::max(0.0, seconds - share.busySeconds);
+    // Idle: waiting at the end for the last device to finish.
+    share.idleSeconds = std::chrono::duration<double>(*std::max_element(ends.begin(), ends.end()) - ends[i]).count();
     const RenderStats& d = perDevice[i];
     st.nonfinite += d.nonfinite;
     st.cameraRays += d.cameraRays;
