@@ -69,6 +69,9 @@ def main():
 
     rows = []
     for method in args.methods.split(","):
+        # A throw-away render first: PoCL compiles each kernel at its first launch, which
+        # would otherwise count in the first point's time.
+        render(args.scene, os.path.join(args.out, f"{name}-{method}-warmup.exr"), 1, method, 999, args, extra)
         spp = 1
         while spp <= args.max_spp:
             image = os.path.join(args.out, f"{name}-{method}-{spp}.exr")
