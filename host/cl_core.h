@@ -32,6 +32,13 @@ cl::Buffer allocateBuffer(const cl::Context& context, const cl::Device& device,
                           cl_mem_flags flags, size_t bytes, const char* what,
                           const void* host = nullptr);
 
+// Sets a kernel's arguments 0, 1, 2, ... in order, each checked.
+template <typename... Args>
+void setKernelArgs(cl::Kernel& kernel, const Args&... args) {
+  cl_uint index = 0;
+  (FH_CL(kernel.setArg(index++, args)), ...);
+}
+
 // Rounds n up to a multiple of `multiple` (global sizes must be whole work-groups).
 inline size_t roundUp(size_t n, size_t multiple) { return (n + multiple - 1) / multiple * multiple; }
 

@@ -21,12 +21,6 @@ void setPathArgs(cl::Kernel& kernel, cl_uint first, const std::vector<cl::Buffer
   for (size_t i = 0; i < state.size(); ++i) FH_CL(kernel.setArg(first + cl_uint(i), state[i]));
 }
 
-template <typename... Args>
-void setArgs(cl::Kernel& kernel, const Args&... args) {
-  cl_uint index = 0;
-  (FH_CL(kernel.setArg(index++, args)), ...);
-}
-
 double filterValue(PixelFilter f, double x, double radius) {
   switch (f) {
     case PixelFilter::Box:
@@ -254,18 +248,18 @@ void PathTracer::enqueueIteration(int current) {
     events_.emplace_back(name, e);
   };
 
-  setArgs(plan_, counters_, rays, nextRays);
+  setKernelArgs(plan_, counters_, rays, nextRays);
   run(plan_, 1, "bookkeeping");
 
-  setArgs(generate_, params_, counters_, freeList_, queue, filterTable_, passTable_);
+  setKernelArgs(generate_, params_, counters_, freeList_, queue, filterTable_, passTable_);
   setPathArgs(generate_, 6, pathState_);
   run(generate_, wavefront_, "generate");
 
-  setArgs(intersect_, scene_.caster.nodes(), scene_.caster.blocks(), queue, counters_, rays, pathState_[0],
+  setKernelArgs(intersect_, scene_.caster.nodes(), scene_.caster.blocks(), queue, counters_, rays, pathState_[0],
           pathState_[1], pathState_[2]);
   run(intersect_, wavefront_, "intersect");
 
-  setArgs(shade_, params_, queue, nextQueue, finishedQueue_, counters_, rays, nextRays, scene_.caster.triangles(),
+  setKernelArgs(shade_, params_, queue, nextQueue, finishedQueue_, counters_, rays, nextRays, scene_.caster.triangles(),
           scene_.triangleMaterial, scene_.materials, scene_.lightPdfArea, scene_.normals, scene_.uvs, scene_.texels,
           scene_.textureInfo);
   setPathArgs(shade_, 15, pathState_);
@@ -273,7 +267,7 @@ void PathTracer::enqueueIteration(int current) {
   run(shade_, wavefront_, "shade");
 
   if (settings_.method != Method::PT && scene_.lightCount > 0) {
-    setArgs(shadowConnect_, params_, counters_, scene_.caster.nodes(), scene_.caster.blocks(),
+    setKernelArgs(shadowConnect_, params_, counters_, scene_.caster.nodes(), scene_.caster.blocks(),
             scene_.caster.triangles(), scene_.triangleMaterial, scene_.materials, scene_.lightCdf,
             scene_.lightTriangle, scene_.lightPdfArea);
     setPathArgs(shadowConnect_, 10, pathState_);
@@ -281,11 +275,11 @@ void PathTracer::enqueueIteration(int current) {
     run(shadowConnect_, wavefront_, "shadow_connect");
   }
 
-  setArgs(accumulatePaths_, finishedQueue_, counters_, freeList_, pixels_, passBuffer_);
+  setKernelArgs(accumulatePaths_, finishedQueue_, counters_, freeList_, pixels_, passBuffer_);
   setPathArgs(accumulatePaths_, 5, pathState_);
   run(accumulatePaths_, wavefront_, "accumulate");
 
-  setArgs(finish_, counters_, rays, nextRays);
+  setKernelArgs(finish_, counters_, rays, nextRays);
   run(finish_, 1, "bookkeeping");
 }
 
@@ -344,7 +338,7 @@ void PathTracer::run(Run& r) {
         FH_CL(dc_.queue.enqueueFillBuffer(passBuffer_, 0u, offset, size_t(pixels_) * 16));
         r.source->done(passTable_host_[r.folded], samples);
       } else {
-        setArgs(accumulatePass_, passBuffer_, unsigned(r.folded), pixels_, filmSum_, filmSumSq_);
+        setKernelArgs(accumulatePass_, passBuffer_, unsigned(r.folded), pixels_, filmSum_, filmSumSq_);
         cl::Event e;
         launch(dc_, accumulatePass_, pixels_, "accumulate_pass", &e);
         events_.emplace_back("accumulate", e);

@@ -33,23 +33,13 @@ RayCaster::RayCaster(DeviceContext& dc, const Bvh& bvh) : dc_(dc) {
 
 void RayCaster::intersectClosest(const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& hits,
                                  unsigned count, cl::Event* event) {
-  FH_CL(closest_.setArg(0, nodes_));
-  FH_CL(closest_.setArg(1, blocks_));
-  FH_CL(closest_.setArg(2, org));
-  FH_CL(closest_.setArg(3, dir));
-  FH_CL(closest_.setArg(4, hits));
-  FH_CL(closest_.setArg(5, count));
+  setKernelArgs(closest_, nodes_, blocks_, org, dir, hits, count);
   launch(dc_, closest_, count, "intersect_closest", event);
 }
 
 void RayCaster::intersectAny(const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& occluded,
                              unsigned count, cl::Event* event) {
-  FH_CL(any_.setArg(0, nodes_));
-  FH_CL(any_.setArg(1, blocks_));
-  FH_CL(any_.setArg(2, org));
-  FH_CL(any_.setArg(3, dir));
-  FH_CL(any_.setArg(4, occluded));
-  FH_CL(any_.setArg(5, count));
+  setKernelArgs(any_, nodes_, blocks_, org, dir, occluded, count);
   launch(dc_, any_, count, "intersect_any", event);
 }
 

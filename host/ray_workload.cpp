@@ -42,14 +42,7 @@ RayQueue RayWorkload::primary(const Camera& camera, int width, int height, unsig
   const unsigned n = unsigned(width) * unsigned(height);
   RayQueue q = allocate(n);
   const gpu::CameraParams cam = makeCameraParams(camera, width, height);
-  FH_CL(generate_.setArg(0, sizeof cam, &cam));
-  FH_CL(generate_.setArg(1, seed));
-  FH_CL(generate_.setArg(2, 0u));
-  FH_CL(generate_.setArg(3, 0u));
-  FH_CL(generate_.setArg(4, q.org));
-  FH_CL(generate_.setArg(5, q.dir));
-  FH_CL(generate_.setArg(6, q.source));
-  FH_CL(generate_.setArg(7, n));
+  setKernelArgs(generate_, cam, seed, 0u, 0u, q.org, q.dir, q.source, n);
   launch(dc_, generate_, n, "generate_camera_rays");
   q.count = n;
   return q;
@@ -64,16 +57,7 @@ cl::Buffer RayWorkload::closestHits(const RayQueue& rays) {
 RayQueue RayWorkload::bounce(const RayQueue& from, const cl::Buffer& hits, unsigned seed) {
   RayQueue q = allocate(from.count);
   FH_CL(dc_.queue.enqueueFillBuffer(counter_, 0u, 0, sizeof(unsigned)));
-  int a = 0;
-  FH_CL(bounce_.setArg(a++, hits));
-  FH_CL(bounce_.setArg(a++, from.dir));
-  FH_CL(bounce_.setArg(a++, caster_.triangles()));
-  FH_CL(bounce_.setArg(a++, seed));
-  FH_CL(bounce_.setArg(a++, q.org));
-  FH_CL(bounce_.setArg(a++, q.dir));
-  FH_CL(bounce_.setArg(a++, q.source));
-  FH_CL(bounce_.setArg(a++, counter_));
-  FH_CL(bounce_.setArg(a++, from.count));
+  setKernelArgs(bounce_, hits, from.dir, caster_.triangles(), seed, q.org, q.dir, q.source, counter_, from.count);
   launch(dc_, bounce_, from.count, "spawn_bounce_rays");
   q.count = readCount();
   return q;
@@ -83,18 +67,8 @@ RayQueue RayWorkload::shadow(const RayQueue& from, const cl::Buffer& hits, unsig
   RayQueue q = allocate(from.count);
   if (lightCount_ == 0) return q;
   FH_CL(dc_.queue.enqueueFillBuffer(counter_, 0u, 0, sizeof(unsigned)));
-  int a = 0;
-  FH_CL(shadow_.setArg(a++, hits));
-  FH_CL(shadow_.setArg(a++, from.dir));
-  FH_CL(shadow_.setArg(a++, caster_.triangles()));
-  FH_CL(shadow_.setArg(a++, lights_));
-  FH_CL(shadow_.setArg(a++, lightCount_));
-  FH_CL(shadow_.setArg(a++, seed));
-  FH_CL(shadow_.setArg(a++, q.org));
-  FH_CL(shadow_.setArg(a++, q.dir));
-  FH_CL(shadow_.setArg(a++, q.source));
-  FH_CL(shadow_.setArg(a++, counter_));
-  FH_CL(shadow_.setArg(a++, from.count));
+  setKernelArgs(shadow_, hits, from.dir, caster_.triangles(), lights_, lightCount_, seed, q.org, q.dir, q.source,
+                counter_, from.count);
   launch(dc_, shadow_, from.count, "spawn_shadow_rays");
   q.count = readCount();
   return q;

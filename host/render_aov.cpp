@@ -50,24 +50,10 @@ Image renderAov(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const Cam
 
   const gpu::CameraParams cam = makeCameraParams(camera, s.width, s.height);
   for (int sample = 0; sample < std::max(1, s.spp); ++sample) {
-    FH_CL(generate.setArg(0, sizeof cam, &cam));
-    FH_CL(generate.setArg(1, s.seed));
-    FH_CL(generate.setArg(2, unsigned(sample)));
-    FH_CL(generate.setArg(3, 0u));
-    FH_CL(generate.setArg(4, org));
-    FH_CL(generate.setArg(5, dir));
-    FH_CL(generate.setArg(6, rayPixel));
-    FH_CL(generate.setArg(7, pixels));
+    setKernelArgs(generate, cam, s.seed, unsigned(sample), 0u, org, dir, rayPixel, pixels);
     launch(dc, generate, pixels, "generate_camera_rays");
     caster.intersectClosest(org, dir, hits, pixels);
-    FH_CL(shade.setArg(0, int(s.mode)));
-    FH_CL(shade.setArg(1, hits));
-    FH_CL(shade.setArg(2, rayPixel));
-    FH_CL(shade.setArg(3, caster.triangles()));
-    FH_CL(shade.setArg(4, materialOf));
-    FH_CL(shade.setArg(5, materialAlbedo));
-    FH_CL(shade.setArg(6, film));
-    FH_CL(shade.setArg(7, pixels));
+    setKernelArgs(shade, int(s.mode), hits, rayPixel, caster.triangles(), materialOf, materialAlbedo, film, pixels);
     launch(dc, shade, pixels, "shade_aov");
   }
   std::vector<float> sums(size_t(pixels) * 4);
