@@ -14,6 +14,7 @@
 
 #include "bvh.h"
 #include "error.h"
+#include "image_io.h"
 #include "ray_workload.h"
 #include "scene_loader.h"
 #include "vec.h"
@@ -159,8 +160,7 @@ std::string sharedScenesDir() {
 }
 
 int runBench(const BenchOptions& o) {
-  if (!o.jsonPath.empty() && fs::exists(o.jsonPath) && !o.force)
-    throw Error("--json '" + o.jsonPath + "': file exists (pass --force to overwrite it)");
+  if (!o.jsonPath.empty()) checkOutputFile(o.jsonPath, o.force, "--json");
   if (o.repeats < 1 || o.width < 1 || o.height < 1) throw Error("--repeats/--width/--height must be positive");
   std::vector<std::string> scenes = o.scenes;
   if (scenes.empty()) scenes = {"cornell", "bunny-box", "sponza", "bunnies-1m"};

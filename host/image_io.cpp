@@ -53,6 +53,11 @@ ImageEncoding checkOutputPath(const std::string& path, bool force, const std::st
   else
     throw Error(flag + " '" + path + "': unknown image extension '" + ext +
                 "' (use .exr, .hdr, .pfm, .png or .jpg)");
+  checkOutputFile(path, force, flag);
+  return encoding;
+}
+
+void checkOutputFile(const std::string& path, bool force, const std::string& flag) {
   const fs::path parent = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
   std::error_code ec;
   if (!fs::is_directory(parent, ec)) throw Error(flag + " '" + path + "': directory '" + parent.string() + "' does not exist");
@@ -61,7 +66,6 @@ ImageEncoding checkOutputPath(const std::string& path, bool force, const std::st
   if (fs::is_directory(path, ec)) throw Error(flag + " '" + path + "': is a directory");
   if (fs::exists(path, ec) && !force)
     throw Error(flag + " '" + path + "': file exists (pass --force to overwrite it)");
-  return encoding;
 }
 
 std::string firstFreeName(const std::string& path) {

@@ -19,6 +19,10 @@ enum class ImageEncoding { LinearFloat, Srgb8 };
 // directory, or an existing file without `force`. Call before rendering.
 ImageEncoding checkOutputPath(const std::string& path, bool force, const std::string& flag = "-o");
 
+// The same checks for any output file (--stats, --json): its directory exists and is
+// writable, it is not a directory, and it does not exist unless `force`.
+void checkOutputFile(const std::string& path, bool force, const std::string& flag);
+
 // The first of base.ext, base-1.ext, base-2.ext ... that does not exist.
 std::string firstFreeName(const std::string& path);
 

@@ -117,9 +117,7 @@ int runRender(RenderOptions o) {
   // An explicit -o is never overwritten without --force; the default name steps aside.
   if (o.output.empty()) o.output = firstFreeName("fredholm.png");
   checkOutputPath(o.output, o.force);
-  if (!o.statsFile.empty()) checkOutputPath(o.statsFile + ".png", true, "--stats");  // the directory
-  if (!o.statsFile.empty() && std::filesystem::exists(o.statsFile) && !o.force)
-    throw Error("--stats '" + o.statsFile + "': file exists (pass --force to overwrite it)");
+  if (!o.statsFile.empty()) checkOutputFile(o.statsFile, o.force, "--stats");
 
   const auto devices = selectDevices(listDevices(), o.device);
 
