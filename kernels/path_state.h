@@ -28,6 +28,17 @@
   X(float4, shadow_throughput, 16)  /* throughput before the BSDF sample, w: bounce count */ \
   X(float4, shadow_wo, 16)          /* direction toward the previous vertex */
 
+// The random dimensions of one bounce, shared by shade and shadow_connect so no two uses
+// of one sample's stream overlap: dimension = bounce * FH_DIMS_PER_BOUNCE + FH_DIM_*.
+#define FH_DIMS_PER_BOUNCE 8
+#define FH_DIM_BSDF_U1 0
+#define FH_DIM_BSDF_U2 1
+#define FH_DIM_ROULETTE 2
+#define FH_DIM_LIGHT_PICK 3
+#define FH_DIM_LIGHT_U1 4
+#define FH_DIM_LIGHT_U2 5
+#define FH_DIM_BSDF_LOBE 6
+
 #ifdef __OPENCL_VERSION__
 #define FH_PATH_PARAM(type, name, bytes) , __global type* name
 // Appended to a kernel's parameter list: `__kernel void k(int a FH_PATH_PARAMS)`.

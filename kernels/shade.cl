@@ -15,13 +15,6 @@
 #error "build with -DFH_METHOD_PT, -DFH_METHOD_NEE or -DFH_METHOD_MIS"
 #endif
 
-// Random dimensions per bounce (the counter-based RNG needs no state).
-#define FH_DIMS_PER_BOUNCE 8
-#define FH_DIM_BSDF_U1 0
-#define FH_DIM_BSDF_U2 1
-#define FH_DIM_ROULETTE 2
-#define FH_DIM_BSDF_LOBE 6
-
 // The weight of emission found by BSDF sampling at a vertex `depth` bounces from the
 // camera; bsdf_pdf < 0 marks a delta (mirror, glass) bounce, which light sampling
 // cannot reproduce, so its emission always counts.

@@ -10,11 +10,6 @@
 #include "rng.h"
 #include "sampling.h"
 
-#define FH_DIMS_PER_BOUNCE 8
-#define FH_DIM_LIGHT_PICK 3
-#define FH_DIM_LIGHT_U1 4
-#define FH_DIM_LIGHT_U2 5
-
 __kernel void shadow_connect(RenderParams params, volatile __global uint* counters,
                              __global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
                              __global const float4* triangles, __global const int* triangle_material,
