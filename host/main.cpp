@@ -1,5 +1,6 @@
-// The fredholm command line: `devices`, `render` and `bench`.
+// The fredholm command line: `devices`, `render`, `bench`, `compare`, `reference` and `export`.
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <chrono>
 #include <optional>
@@ -21,6 +22,7 @@
 #include "path_tracer.h"
 #include "render_aov.h"
 #include "scene_loader.h"
+#include "scene_writer.h"
 #include "vec.h"
 #ifdef FREDHOLM_HAVE_EMBREE
 #include "embree_tracer.h"
@@ -79,6 +81,12 @@ Camera chooseCamera(const RenderOptions& o, const Scene& scene) {
   return camera;
 }
 
+// An OBJ path, builtin:NAME, or nothing for the built-in Cornell box.
+Scene loadSceneSpec(const std::string& spec) {
+  if (spec.empty()) return loadDefaultScene();
+  return isBuiltinSpec(spec) ? builtinScene(spec) : loadScene(spec);
+}
+
 int runDevices(const std::string& spec) {
   const auto all = listDevices();
   std::cout << formatDeviceTable(spec.empty() ? all : selectDevices(all, spec));
@@ -121,9 +129,7 @@ int runRender(RenderOptions o) {
 
   const auto devices = selectDevices(listDevices(), o.device);
 
-  const Scene scene = o.scene.empty()          ? loadDefaultScene()
-                      : isBuiltinSpec(o.scene) ? builtinScene(o.scene)
-                                               : loadScene(o.scene);
+  const Scene scene = loadSceneSpec(o.scene);
   printWarnings(scene);
   const Camera camera = chooseCamera(o, scene);
   const auto start = std::chrono::steady_clock::now();
@@ -200,6 +206,58 @@ int runRender(RenderOptions o) {
   return 0;
 }
 
+struct CompareOptions {
+  std::string image, reference;
+  int block = 1;
+};
+
+int runCompare(const CompareOptions& o) {
+  for (const std::string* path : {&o.image, &o.reference})
+    if (!std::filesystem::is_regular_file(*path)) throw Error(*path + ": image not found");
+  if (o.block < 1) throw Error("--block must be at least 1");
+  Image image = readImage(o.image), reference = readImage(o.reference);
+  if (o.block > 1) {
+    try {
+      image = blockAverage(image, o.block);
+      reference = blockAverage(reference, o.block);
+    } catch (const Error& e) {
+      throw Error(std::string("--block: ") + e.what());
+    }
+  }
+  const ImageError e = imageError(image, reference);
+  const nlohmann::json out = {{"relmse", e.relMse}, {"rmse", e.rmse}, {"mae", e.mae},
+                              {"mean_image", e.meanImage}, {"mean_reference", e.meanReference},
+                              {"block", o.block}};
+  std::cout << out.dump() << "\n";
+  return 0;
+}
+
+struct ReferenceOptions {
+  std::string scene, output;
+  int width = 128, height = 128;
+  bool force = false;
+};
+
+int runReference(const ReferenceOptions& o) {
+  checkOutputPath(o.output, o.force);
+  if (o.width <= 0 || o.height <= 0) throw Error("--width/--height must be positive");
+  writeImage(o.output, builtinReference(o.scene, o.width, o.height), {{"scene", o.scene}, {"method", "exact"}});
+  std::cout << "wrote " << o.output << "\n";
+  return 0;
+}
+
+struct ExportOptions {
+  std::string scene, output;
+  bool force = false;
+};
+
+int runExport(const ExportOptions& o) {
+  const Scene scene = loadSceneSpec(o.scene);
+  printWarnings(scene);
+  for (const std::string& written : writeObjScene(scene, o.output, o.force)) std::cout << "wrote " << written << "\n";
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -258,20 +316,29 @@ int main(int argc, char** argv) {
   bench.external = makeEmbreeTracer;
 #endif
 
-  std::string compareImage, compareReference;
-  auto* comparing = app.add_subcommand("compare", "Error of an image against a reference (relMSE, RMSE, MAE) as JSON");
-  comparing->add_option("image", compareImage, "Rendered image (.exr .hdr .pfm ...)")->required();
-  comparing->add_option("reference", compareReference, "Reference image of the same size")->required();
+  CompareOptions compare;
+  auto* comparing = app.add_subcommand(
+      "compare", "Error of an image against a reference as JSON: relMSE, RMSE, MAE and each image's channel means");
+  comparing->add_option("image", compare.image, "Rendered image (.exr .hdr .pfm ...)")->required();
+  comparing->add_option("reference", compare.reference, "Reference image of the same size")->required();
+  comparing->add_option("--block", compare.block, "Average KxK pixel blocks of both first (K divides the size)")
+      ->capture_default_str();
 
-  std::string referenceScene, referenceOutput;
-  int referenceWidth = 128, referenceHeight = 128;
-  bool referenceForce = false;
+  ReferenceOptions reference;
   auto* referencing = app.add_subcommand("reference", "Write the exact image of a closed-form scene (builtin:NAME)");
-  referencing->add_option("scene", referenceScene, "builtin:plane-under-light")->required();
-  referencing->add_option("-o,--output", referenceOutput, "Output image")->required();
-  referencing->add_option("--width", referenceWidth, "Image width")->capture_default_str();
-  referencing->add_option("--height", referenceHeight, "Image height")->capture_default_str();
-  referencing->add_flag("--force", referenceForce, "Overwrite an existing output file");
+  referencing->add_option("scene", reference.scene, "builtin:plane-under-light")->required();
+  referencing->add_option("-o,--output", reference.output, "Output image")->required();
+  referencing->add_option("--width", reference.width, "Image width")->capture_default_str();
+  referencing->add_option("--height", reference.height, "Image height")->capture_default_str();
+  referencing->add_flag("--force", reference.force, "Overwrite an existing output file");
+
+  ExportOptions exporting;
+  auto* exporter = app.add_subcommand(
+      "export", "Write a scene (an OBJ, or builtin:NAME) as OBJ + MTL + camera.json, e.g. for another renderer");
+  exporter->add_option("scene", exporting.scene, "OBJ file or builtin:plane-under-light (default: the Cornell box)");
+  exporter->add_option("-o,--output", exporting.output, "Output .obj (the .mtl and .camera.json go beside it)")
+      ->required();
+  exporter->add_flag("--force", exporting.force, "Overwrite existing files");
 
   try {
     app.parse(argc, argv);
@@ -282,21 +349,9 @@ int main(int argc, char** argv) {
     if (*devices) return runDevices(devicesSpec);
     if (*rendering) return runRender(render);
     if (*benching) return runBench(bench);
-    if (*referencing) {
-      checkOutputPath(referenceOutput, referenceForce);
-      if (referenceWidth <= 0 || referenceHeight <= 0) throw Error("--width/--height must be positive");
-      writeImage(referenceOutput, builtinReference(referenceScene, referenceWidth, referenceHeight),
-                 {{"scene", referenceScene}, {"method", "exact"}});
-      std::cout << "wrote " << referenceOutput << "\n";
-      return 0;
-    }
-    if (*comparing) {
-      for (const std::string* path : {&compareImage, &compareReference})
-        if (!std::filesystem::is_regular_file(*path)) throw Error(*path + ": image not found");
-      const ImageError e = imageError(readImage(compareImage), readImage(compareReference));
-      std::cout << "{\"relmse\": " << e.relMse << ", \"rmse\": " << e.rmse << ", \"mae\": " << e.mae << "}\n";
-      return 0;
-    }
+    if (*referencing) return runReference(reference);
+    if (*comparing) return runCompare(compare);
+    if (*exporter) return runExport(exporting);
   } catch (const BuildError& e) {
     std::cerr << "fredholm: error: " << e.what() << "\n";
     return 1;

@@ -105,5 +105,55 @@ TEST(ReferenceCli, ExactImageOfTheClosedFormSceneAndItsErrors) {
   EXPECT_EQ(rendered.exitCode, 0) << rendered.output;
 }
 
+
+TEST(ExportCli, BuiltinAndObjScenesRoundTripToTheSameImage) {
+  const std::string dir = test::tempDir("cli");
+  for (const std::string scene : {"builtin:plane-under-light", ""}) {
+    const std::string obj = dir + "/exported" + (scene.empty() ? "-cornell" : "-plane") + ".obj";
+    const auto exported = test::runFredholm("export " + scene + " -o " + obj);
+    ASSERT_EQ(exported.exitCode, 0) << exported.output;
+    EXPECT_NE(exported.output.find(".camera.json"), std::string::npos) << exported.output;
+    // The same scene, camera and seed from the original and from the written files.
+    const std::string flags = " --width 12 --height 10 --spp 8 --seed 3 --force -o ";
+    const auto a = test::runFredholm("render " + scene + flags + dir + "/a.exr");
+    const auto b = test::runFredholm("render " + obj + flags + dir + "/b.exr");
+    ASSERT_EQ(a.exitCode, 0) << a.output;
+    ASSERT_EQ(b.exitCode, 0) << b.output;
+    EXPECT_EQ(readImage(dir + "/a.exr").rgb, readImage(dir + "/b.exr").rgb) << scene;
+    const auto again = test::runFredholm("export " + scene + " -o " + obj);
+    EXPECT_EQ(again.exitCode, 1);
+    EXPECT_NE(again.output.find("file exists"), std::string::npos) << again.output;
+  }
+  const auto notObj = test::runFredholm("export -o " + dir + "/x.ply");
+  EXPECT_EQ(notObj.exitCode, 1);
+  EXPECT_NE(notObj.output.find("must end in .obj"), std::string::npos) << notObj.output;
+}
+
+TEST(CompareCli, MetricsMeansAndBlocks) {
+  const std::string dir = test::tempDir("cli");
+  Image a, b;
+  a.width = b.width = 4;
+  a.height = b.height = 2;
+  a.rgb.assign(24, 1.f);
+  b.rgb.assign(24, 1.f);
+  for (int x = 0; x < 2; ++x) a.rgb[size_t(3 * x)] = 3.f;  // two red pixels of one 2x2 block: block mean 2
+  writeImage(dir + "/a.exr", a, {});
+  writeImage(dir + "/b.exr", b, {});
+  const auto pixels = test::runFredholm("compare " + dir + "/a.exr " + dir + "/b.exr");
+  ASSERT_EQ(pixels.exitCode, 0) << pixels.output;
+  const auto j = nlohmann::json::parse(pixels.output);
+  EXPECT_NEAR(j["mae"].get<double>(), 4.0 / 24, 1e-6);
+  EXPECT_NEAR(j["mean_image"][0].get<double>(), 1.5, 1e-6);
+  EXPECT_NEAR(j["mean_reference"][0].get<double>(), 1.0, 1e-6);
+  const auto blocks = test::runFredholm("compare --block 2 " + dir + "/a.exr " + dir + "/b.exr");
+  ASSERT_EQ(blocks.exitCode, 0) << blocks.output;
+  // Blocks: red 2 vs 1 in one of 2 blocks x 3 channels: relMSE 1 / 1.01 / 6.
+  EXPECT_NEAR(nlohmann::json::parse(blocks.output)["relmse"].get<double>(), 1.0 / 1.01 / 6, 1e-6);
+  const auto bad = test::runFredholm("compare --block 3 " + dir + "/a.exr " + dir + "/b.exr");
+  EXPECT_EQ(bad.exitCode, 1);
+  EXPECT_NE(bad.output.find("--block: block size 3 does not divide the image (4x2)"), std::string::npos)
+      << bad.output;
+}
+
 }  // namespace
 }  // namespace fh

@@ -127,6 +127,22 @@ TEST(ErrorMetrics, KnownValues) {
   Image small = ref;
   small.width = 1;
   EXPECT_THROW(imageError(small, ref), Error);
+  EXPECT_NEAR(e.meanImage[0], 0.8, 1e-6);
+  EXPECT_NEAR(e.meanReference[0], 0.5, 1e-6);
+}
+
+TEST(ErrorMetrics, BlockAverage) {
+  Image img;
+  img.width = 4;
+  img.height = 2;
+  for (int i = 0; i < 8; ++i) img.rgb.insert(img.rgb.end(), {float(i), 1.f, 0.f});
+  const Image b = blockAverage(img, 2);
+  ASSERT_EQ(b.width, 2);
+  ASSERT_EQ(b.height, 1);
+  EXPECT_EQ(b.rgb, (std::vector<float>{(0 + 1 + 4 + 5) / 4.f, 1.f, 0.f, (2 + 3 + 6 + 7) / 4.f, 1.f, 0.f}));
+  EXPECT_EQ(blockAverage(img, 1).rgb, img.rgb);
+  EXPECT_THROW(blockAverage(img, 3), Error);
+  EXPECT_THROW(blockAverage(img, 0), Error);
 }
 
 }  // namespace
