@@ -23,7 +23,7 @@ struct PlaneUnderLight {
   static std::vector<float3> light();
   // Radiance along the camera ray through direction d; *surface: -1 none, 0 plane, 1 light.
   static double radiance(const Camera& camera, const float3& d, int* surface);
-  // The exact image (box filter: each pixel the mean over a sub x sub grid). With
+  // The exact image (box filter: each pixel the mean of sub^2 well-spread points). With
   // markEdges, pixels whose footprint sees more than one surface are NaN.
   static Image reference(const Camera& camera, int width, int height, int sub, bool markEdges);
 };
