@@ -5,7 +5,11 @@
 // - a diffuse plane under a one-sided rectangular emitter: Lambert's polygon formula;
 // - a plane under a constant environment: rho * L_env;
 // - pt, nee and mis agree on the Cornell box within their combined noise;
-// - no sample is ever NaN or infinite; the image is deterministic for a seed.
+// - no sample is ever NaN or infinite; the image is deterministic for a seed;
+// - "where methods fail": scenes built to defeat one strategy each (extreme scales, long
+//   paths, degenerate emitters, a tiny light, caustics through glass, a hidden light,
+//   near-mirror plates, grazing angles) stay finite and agree, and mis stays near the
+//   better method.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -154,53 +158,88 @@ TEST_P(EveryMethod, PlaneUnderConstantEnvironmentIsRhoTimesEnv) {
   expectMatches(r.film, [&](size_t) { return rho * env; }, methodName(GetParam()));
 }
 
-TEST(PathTracer, MethodsAgreeOnTheCornellBox) {
-  const Scene scene = loadDefaultScene();
-  const int size = 24, spp = 256;
-  const Rendered pt = render(scene, scene.camera, Method::PT, size, spp, 11);
-  const Rendered nee = render(scene, scene.camera, Method::NEE, size, spp, 12);
-  const Rendered mis = render(scene, scene.camera, Method::MIS, size, spp, 13);
-  for (const Rendered* r : {&pt, &nee, &mis}) EXPECT_EQ(r->stats.nonfinite, 0u);
-  // Each pair: the difference of two independent estimates has the sum of their variances.
-  // Compared over 4x4-pixel blocks (4096 samples each): pt's per-pixel means at 256 spp are
-  // too skewed (rare hits on the small light) for a per-pixel normal test.
-  const int block = 4;
+// Two independent renders of one scene agree: their difference has the sum of their
+// variances. Compared over blocks of block x block pixels (4x4: 4096 samples each at 256
+// spp): per-pixel means of pt are too skewed (rare hits on a small light) for a per-pixel
+// normal test. Where one method's samples are heavy-tailed (caustics found by BSDF
+// sampling, light samples on near-mirror lobes) the sample variance of a few thousand
+// understates the true one, and larger blocks are needed.
+void expectAgree(const Film& a, const Film& b, const std::string& what, int block = 4) {
   auto blockStats = [&](const Film& f, int bx, int by, double& mean, double& var) {
     mean = var = 0;
     for (int y = by * block; y < (by + 1) * block; ++y)
       for (int x = bx * block; x < (bx + 1) * block; ++x) {
-        const size_t p = size_t(y * size + x);
+        const size_t p = size_t(y * f.width + x);
         mean += luminanceMean(f, p) / (block * block);
         var += pixelVariance(f, p) / double(block * block * block * block);
       }
   };
-  auto agree = [&](const Film& a, const Film& b, const std::string& what) {
-    double diff = 0, var = 0;
-    int outliers = 0, n = 0;
-    for (int by = 0; by < size / block; ++by)
-      for (int bx = 0; bx < size / block; ++bx) {
-        double ma, va, mb, vb;
-        blockStats(a, bx, by, ma, va);
-        blockStats(b, bx, by, mb, vb);
-        diff += ma - mb;
-        var += va + vb;
-        ++n;
-        if (std::fabs(ma - mb) > 3.29 * std::sqrt(va + vb)) ++outliers;
-      }
-    EXPECT_LT(std::fabs(diff / std::sqrt(var)), kZ) << what << ": mean difference " << diff / n;
-    EXPECT_LE(outliers, 2) << what << ": " << outliers << " of " << n << " blocks outside 3.29 sigma";
-  };
-  agree(pt.film, nee.film, "pt vs nee");
-  agree(pt.film, mis.film, "pt vs mis");
-  agree(nee.film, mis.film, "nee vs mis");
-  // mis should be no noisier than the better of the two on this scene.
-  double vPt = 0, vNee = 0, vMis = 0;
-  for (size_t p = 0; p < size_t(size) * size; ++p) {
-    vPt += pixelVariance(pt.film, p);
-    vNee += pixelVariance(nee.film, p);
-    vMis += pixelVariance(mis.film, p);
-  }
-  EXPECT_LT(vMis, 1.5 * std::min(vPt, vNee));
+  double diff = 0, var = 0;
+  int outliers = 0, n = 0;
+  for (int by = 0; by < a.height / block; ++by)
+    for (int bx = 0; bx < a.width / block; ++bx) {
+      double ma, va, mb, vb;
+      blockStats(a, bx, by, ma, va);
+      blockStats(b, bx, by, mb, vb);
+      diff += ma - mb;
+      var += va + vb;
+      ++n;
+      if (std::fabs(ma - mb) > 3.29 * std::sqrt(va + vb)) ++outliers;
+    }
+  EXPECT_LT(std::fabs(diff / std::sqrt(var)), kZ) << what << ": mean difference " << diff / n;
+  EXPECT_LE(outliers, 2 + n / 50) << what << ": " << outliers << " of " << n << " blocks outside 3.29 sigma";
+}
+
+double imageVariance(const Film& f) {
+  double v = 0;
+  for (size_t p = 0; p < size_t(f.width) * size_t(f.height); ++p) v += pixelVariance(f, p);
+  return v;
+}
+
+struct ThreeMethods {
+  Rendered pt, nee, mis;
+};
+
+// pt, nee and mis of one scene, with independent seeds or, with `commonSeed`, one seed for
+// all: every bounce draws its BSDF sample from the same random dimensions whatever the
+// method, so the three then trace the same BSDF-sampled paths (common random numbers).
+// Checks every sample is finite.
+ThreeMethods renderAllMethods(const Scene& scene, const Camera& camera, int size, int spp, bool commonSeed = false) {
+  const unsigned seed = commonSeed ? 21 : 11;
+  ThreeMethods r{render(scene, camera, Method::PT, size, spp, seed),
+                 render(scene, camera, Method::NEE, size, spp, commonSeed ? seed : 12),
+                 render(scene, camera, Method::MIS, size, spp, commonSeed ? seed : 13)};
+  EXPECT_EQ(r.pt.stats.nonfinite, 0u) << "pt";
+  EXPECT_EQ(r.nee.stats.nonfinite, 0u) << "nee";
+  EXPECT_EQ(r.mis.stats.nonfinite, 0u) << "mis";
+  return r;
+}
+
+// The same, and the three agree pairwise.
+ThreeMethods renderAllMethodsAndCompare(const Scene& scene, const Camera& camera, int size, int spp,
+                                        const std::string& what, int block = 4) {
+  ThreeMethods r = renderAllMethods(scene, camera, size, spp);
+  expectAgree(r.pt.film, r.nee.film, what + ": pt vs nee", block);
+  expectAgree(r.pt.film, r.mis.film, what + ": pt vs mis", block);
+  expectAgree(r.nee.film, r.mis.film, what + ": nee vs mis", block);
+  return r;
+}
+
+// "mis is never much worse than the better of pt and nee": its image variance at equal
+// samples within 1.5x of the better one's. Measured with common random numbers: where rare
+// paths dominate the variance (caustics, which every method finds by BSDF sampling alone),
+// independent seeds would compare the luck of the draws (nee 0.94 vs mis 1.50 at one seed
+// pair on the caustic scene), not the estimators.
+void expectMisNearTheBetter(const Scene& scene, const Camera& camera, int size, int spp, const std::string& what) {
+  const ThreeMethods r = renderAllMethods(scene, camera, size, spp, true);
+  const double vPt = imageVariance(r.pt.film), vNee = imageVariance(r.nee.film), vMis = imageVariance(r.mis.film);
+  EXPECT_LT(vMis, 1.5 * std::min(vPt, vNee)) << what << ": variance pt " << vPt << " nee " << vNee << " mis " << vMis;
+}
+
+TEST(PathTracer, MethodsAgreeOnTheCornellBox) {
+  const Scene scene = loadDefaultScene();
+  renderAllMethodsAndCompare(scene, scene.camera, 24, 256, "Cornell box");
+  expectMisNearTheBetter(scene, scene.camera, 24, 256, "Cornell box");
 }
 
 TEST(PathTracer, SpecializedAndAllFeatureKernelsAgree) {
@@ -392,6 +431,74 @@ TEST(WhereMethodsFail, TinyBrightLight) {
   const double ePt = squaredError(pt.film), eNee = squaredError(nee.film), eMis = squaredError(mis.film);
   EXPECT_LT(eMis, 1.5 * std::min(ePt, eNee)) << "pt " << ePt << " nee " << eNee << " mis " << eMis;
   EXPECT_GT(ePt, 10 * eNee) << "pt " << ePt << " nee " << eNee;  // the failure this scene is for
+}
+
+// Caustics through glass (scenes/failure/caustic.obj): a ball lens focuses a small light on
+// the floor. That light arrives through two refractions, which no light sample connects,
+// so every method must find it by BSDF sampling and count the emission after the specular
+// chain exactly once. Checks: finite, the methods agree, mis near the better, and the
+// caustic is there: the brightest 4x4 block (0.2 units of floor) is more than 1.5 times as
+// bright as the floor under the bare light (measured: 2.2-2.9 times, the ball's spherical
+// aberration spreads the focus; without the caustic paths, 0.8 times).
+TEST(WhereMethodsFail, CausticsThroughGlass) {
+  const Scene scene = loadScene(test::projectScene("failure/caustic.obj"));
+  const int size = 32;
+  const ThreeMethods r = renderAllMethodsAndCompare(scene, scene.camera, size, 256, "caustic", 8);
+  expectMisNearTheBetter(scene, scene.camera, size, 256, "caustic");
+  const float half = 0.15f, h = 3.34f, le = 40.f;  // the light, as scenes/failure/make_scenes.py writes it
+  const std::vector<float3> light = {{-half, h, -half}, {half, h, -half}, {half, h, half}, {-half, h, half}};
+  const double bareFloor = 0.7 / M_PI * lambertIrradiance({0, 0, 0}, {0, 1, 0}, light, le);
+  for (const Rendered* m : {&r.pt, &r.nee, &r.mis}) {
+    double brightest = 0;
+    for (int by = 0; by < size / 4; ++by)
+      for (int bx = 0; bx < size / 4; ++bx) {
+        double sum = 0;
+        for (int y = 4 * by; y < 4 * by + 4; ++y)
+          for (int x = 4 * bx; x < 4 * bx + 4; ++x) sum += luminanceMean(m->film, size_t(y * size + x)) / 16;
+        brightest = std::max(brightest, sum);
+      }
+    EXPECT_GT(brightest, 1.5 * bareFloor) << "no caustic: brightest block " << brightest << ", bare floor " << bareFloor;
+  }
+}
+
+// A light hidden behind a partition (scenes/failure/hidden-light.obj): what the camera sees
+// is lit over the wall, so light samples from the first vertex are mostly blocked and the
+// light is found from the second or third. Finite, the methods agree, mis near the better.
+TEST(WhereMethodsFail, LightHiddenBehindACorner) {
+  const Scene scene = loadScene(test::projectScene("failure/hidden-light.obj"));
+  renderAllMethodsAndCompare(scene, scene.camera, 24, 256, "hidden light", 8);
+  expectMisNearTheBetter(scene, scene.camera, 24, 256, "hidden light");
+}
+
+// Large lights in near-mirror plates (the Veach MIS scene): light samples on the sharp
+// lobes are spiky, so nee's estimate is heavy-tailed: its image mean over three seeds at
+// 8192 spp (24x24) was 0.92, 0.73, 0.70 against mis's 0.761, 0.754, 0.754 and pt's 0.760,
+// 0.757, 0.755 (bench/RESULTS.md). Its sample variance then understates the true one, and
+// no z-test of nee is meaningful here; pt and mis must agree, and mis must be within 1.5x
+// of the better method's variance (pt's, here).
+TEST(WhereMethodsFail, LargeLightsInNearMirrorGlossyPlates) {
+  if (!test::haveSharedScenes()) GTEST_SKIP() << "../shared/scenes not present";
+  const Scene scene = loadScene(test::sharedScene("veach-mis/veach_mis.obj"));
+  const ThreeMethods r = renderAllMethods(scene, scene.camera, 24, 256);
+  expectAgree(r.pt.film, r.mis.film, "Veach MIS: pt vs mis", 8);
+  expectMisNearTheBetter(scene, scene.camera, 24, 256, "Veach MIS");
+}
+
+// A plane seen and lit at grazing angles: the camera 2 cm above a 10 x 10 plane, whose far
+// parts get the light at a few degrees; against Lambert's formula, every method.
+TEST(WhereMethodsFail, GrazingAngles) {
+  const Scene scene = PlaneUnderLight::scene();
+  Camera camera = scene.camera;
+  camera.eye = {0.f, 0.02f, 4.9f};
+  camera.target = {0.f, 0.f, -5.f};
+  camera.fovYDeg = 2.f;  // the view spans the plane from 1.4 units ahead to its far edge
+  const int size = 24;
+  const Image exact = PlaneUnderLight::reference(camera, size, size, 8, true);
+  for (Method m : {Method::PT, Method::NEE, Method::MIS}) {
+    const Rendered r = render(scene, camera, m, size, 256, 7);
+    EXPECT_EQ(r.stats.nonfinite, 0u);
+    expectMatches(r.film, [&](size_t p) { return double(exact.rgb[3 * p]); }, methodName(m));
+  }
 }
 
 }  // namespace

@@ -19,6 +19,10 @@ std::string sharedScene(const std::string& relative) {
   return haveSharedScenes() ? std::string(FREDHOLM_SHARED_SCENES) + "/" + relative : "";
 }
 
+std::string projectScene(const std::string& relative) {
+  return std::string(FREDHOLM_SOURCE_DIR) + "/scenes/" + relative;
+}
+
 namespace {
 struct TempDirs {
   std::vector<fs::path> dirs;

@@ -8,6 +8,8 @@ namespace fh::test {
 // Absolute path of a file in ../shared/scenes, or "" if the corpus is absent.
 std::string sharedScene(const std::string& relative);
 bool haveSharedScenes();
+// Absolute path of a file in this repository's scenes/ (always present).
+std::string projectScene(const std::string& relative);
 
 // A fresh empty directory under the system temp dir, removed at exit.
 std::string tempDir(const std::string& tag);
