@@ -14,7 +14,6 @@ about relMSE(max-spp run) * max-spp / ref-spp. Needs Debian's python3-matplotlib
 import argparse
 import csv
 import json
-import math
 import os
 import subprocess
 import sys
@@ -23,6 +22,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+
+from converge_table import equal_time  # noqa: E402  (beside this script)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FREDHOLM = os.path.join(ROOT, "build", "fredholm")
@@ -106,24 +107,9 @@ def main():
     chart = os.path.join(args.out, f"{name}.png")
     fig.savefig(chart, dpi=110)
 
-    # relMSE at equal time: each method's curve interpolated (log-log) at the longest time
-    # every method reached.
-    target = min(max(r["seconds"] for r in rows if r["method"] == m) for m in args.methods.split(","))
-    print(f"relMSE at {target:.2f} s:")
-    for method in args.methods.split(","):
-        pts = [r for r in rows if r["method"] == method]
-        below = [r for r in pts if r["seconds"] <= target]
-        above = [r for r in pts if r["seconds"] >= target]
-        if not below or not above:
-            print(f"  {method}: (not bracketed)")
-            continue
-        a, b = below[-1], above[0]
-        if a is b:
-            value = a["relMSE"]
-        else:
-            f = (math.log(target) - math.log(a["seconds"])) / (math.log(b["seconds"]) - math.log(a["seconds"]))
-            value = math.exp(math.log(a["relMSE"]) + f * (math.log(b["relMSE"]) - math.log(a["relMSE"])))
-        print(f"  {method}: {value:.3e}")
+    # relMSE at equal time: each method's curve read at the longest time all reached.
+    target, values = equal_time(rows)
+    print(f"relMSE at {target:.2f} s: " + ", ".join(f"{m} {v:.3e}" for m, v in values.items()))
     print(f"wrote {table} and {chart}")
 
 

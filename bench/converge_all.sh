@@ -1,0 +1,35 @@
+#!/bin/sh
+# Every error-against-time chart of bench/RESULTS.md and the method x scene table, from a
+# fresh clone (after ./setup.sh build; ../shared/scenes beside the repository for the
+# archive's scenes). About 15 minutes on 2 cores. CSVs and charts land in bench/convergence/,
+# images and references in bench/out/converge/.
+set -eu
+cd "$(dirname "$0")/.."
+out=bench/out/converge
+shared=../shared/scenes
+mkdir -p "$out" bench/convergence
+
+chart() {  # chart NAME converge.py-arguments...
+  name=$1
+  shift
+  echo "== $name"
+  bench/converge.py "$@" --out "$out"
+  cp "$out/$name.csv" "$out/$name.png" bench/convergence/
+}
+
+# The closed-form scene against its exact image.
+build/fredholm reference builtin:plane-under-light --width 128 --height 128 -o "$out/plane-exact.exr" --force
+chart builtin-plane-under-light builtin:plane-under-light --ref "$out/plane-exact.exr" --max-spp 256
+# The rest against long mis renders of fredholm itself.
+chart cornell-box --ref-spp 4096 --max-spp 256
+for s in caustic hidden-light tiny-light; do
+  chart "$s" "scenes/failure/$s.obj" --ref-spp 4096 --max-spp 256
+done
+if [ -d "$shared" ]; then
+  chart CornellBox-Glossy "$shared/cornell-box/legacy-glossy-2011/CornellBox-Glossy.obj" --ref-spp 2048 --max-spp 128
+  chart veach_mis "$shared/veach-mis/veach_mis.obj" --width 192 --height 128 --ref-spp 2048 --max-spp 128
+  chart CornellBox-Water "$shared/cornell-box/CornellBox-Water.obj" --ref-spp 2048 --max-spp 128
+else
+  echo "($shared not found: the archive's scenes are left out)"
+fi
+/usr/bin/python3 bench/converge_table.py bench/convergence
