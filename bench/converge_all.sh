@@ -1,7 +1,7 @@
 #!/bin/sh
 # Every error-against-time chart of bench/RESULTS.md and the method x scene table, from a
 # fresh clone (after ./setup.sh build; ../shared/scenes beside the repository for the
-# archive's scenes). About 15 minutes on 2 cores. CSVs and charts land in bench/convergence/,
+# archive's scenes). About 8 minutes on 2 cores. CSVs and charts land in bench/convergence/,
 # images and references in bench/out/converge/.
 set -eu
 cd "$(dirname "$0")/.."

@@ -12,19 +12,22 @@ What it sets up, so that Cycles solves the same equation fredholm does:
   emission of the MTL's Ke on the front face only (Geometry > Backfacing selects the plain
   diffuse behind); Cycles' Emission strength 1 means radiance = colour, which
   bench/cycles_compare.sh checks on the closed-form plane under a light;
+- faces that repeat an earlier face exactly removed (see remove_duplicate_faces);
 - a black world, the camera from the JSON (eye, target, up, vertical field of view);
 - box pixel filter 1 pixel wide, no denoising, no clamping, no adaptive sampling, no light
   threshold, no glossy blur, the same bounce limit for every kind, Standard view transform
-  (an EXR is written linear anyway);
+  (an EXR is written linear anyway).
 Only scenes that need nothing more than diffuse + emission are accepted (illum 0-2 with
 Ks 0): anything else would not be an exact equivalent.
 """
 import argparse
 import json
 import math
+import os
 import re
 import sys
 
+import bmesh
 import bpy
 from mathutils import Matrix, Vector
 
@@ -50,7 +53,6 @@ def fail(message):
 
 def read_mtl(obj_path):
     """Kd and Ke of each material of the OBJ's mtllib files; rejects anything not Lambertian."""
-    import os
     materials = {}
     with open(obj_path) as f:
         libs = [line.split(None, 1)[1].strip() for line in f if line.startswith("mtllib")]
@@ -121,7 +123,6 @@ def remove_duplicate_faces(obj):
     by an offset, so a second copy of the same face shadows the first: the archive's Cornell
     box has two (its "Bottom Face" lines index the front faces again), which Cycles renders
     black. A duplicate adds no surface, so removing it leaves the scene the same."""
-    import bmesh
     bm = bmesh.new()
     bm.from_mesh(obj.data)
     seen, duplicates = set(), []
