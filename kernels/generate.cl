@@ -4,7 +4,7 @@
 #include "camera.h"
 #include "film.h"
 #include "path_state.h"
-#include "rng.h"
+#include "sampler.h"
 
 // Plans one iteration (a single work-item): how many new samples start (as many as free
 // slots, up to the limit the host set), where they take their slots and queue places,
@@ -41,7 +41,8 @@ __kernel void generate_paths(RenderParams params, __global const uint* counters,
   const uint pixel = j % params.pixel_count, device_pass = j / params.pixel_count;
   const uint pass = pass_table[device_pass];
   const uint k = pass * params.pixel_count + pixel;
-  const float2 u = pixel_sample_2d(params.seed, pixel, pass);
+  const PixelSampler sampler = pixel_sampler(params.seed, k, params.pixel_count);
+  const float2 u = sample_2d(&sampler, FH_DIM_PIXEL);
   const float px = (float)(pixel % (uint)params.camera.width) + 0.5f +
                    filter_offset(filter_table, params.filter_table_size, u.x);
   const float py = (float)(pixel / (uint)params.camera.width) + 0.5f +

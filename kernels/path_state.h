@@ -29,7 +29,8 @@
   X(float4, shadow_wo, 16)          /* direction toward the previous vertex */
 
 // The random dimensions of one bounce, shared by shade and shadow_connect so no two uses
-// of one sample's stream overlap: dimension = bounce * FH_DIMS_PER_BOUNCE + FH_DIM_*.
+// of one sample's numbers overlap: dimension = bounce * FH_DIMS_PER_BOUNCE + FH_DIM_*.
+// The pixel sampler (sampler.h) draws U1/U2 pairs together as one 2D point.
 #define FH_DIMS_PER_BOUNCE 8
 #define FH_DIM_BSDF_U1 0
 #define FH_DIM_BSDF_U2 1
@@ -38,6 +39,8 @@
 #define FH_DIM_LIGHT_U1 4
 #define FH_DIM_LIGHT_U2 5
 #define FH_DIM_BSDF_LOBE 6
+// The sub-pixel position (two dimensions), far above every bounce's.
+#define FH_DIM_PIXEL 0x7fff0000u
 
 #ifdef __OPENCL_VERSION__
 #define FH_PATH_PARAM(type, name, bytes) , __global type* name

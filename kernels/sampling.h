@@ -25,6 +25,18 @@ FH_INLINE float2 sincos_quarter(float x) {
   return (float2)(s, c);
 }
 
+// sin and cos of any moderate angle: reduced by quarter turns to [-pi/4, pi/4].
+FH_INLINE float2 sincos_reduced(float x) {
+  const float k = rint(x * M_2_PI_F);
+  const float2 sc = sincos_quarter(x - k * M_PI_2_F);
+  switch (((int)k) & 3) {
+    case 0: return sc;
+    case 1: return (float2)(sc.y, -sc.x);
+    case 2: return -sc;
+    default: return (float2)(-sc.y, sc.x);
+  }
+}
+
 // A uniform point on the unit disk from [0,1)^2 by Shirley and Chiu's concentric
 // mapping (area-preserving, so stratified inputs stay stratified).
 FH_INLINE float2 sample_concentric_disk(float u1, float u2) {

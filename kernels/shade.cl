@@ -8,7 +8,7 @@
 #include "lights.h"
 #include "path_state.h"
 #include "ray.h"
-#include "rng.h"
+#include "sampler.h"
 #include "surface.h"
 
 #if !defined(FH_METHOD_PT) && !defined(FH_METHOD_NEE) && !defined(FH_METHOD_MIS)
@@ -16,16 +16,22 @@
 #endif
 
 // The weight of emission found by BSDF sampling at a vertex `depth` bounces from the
-// camera; bsdf_pdf < 0 marks a delta (mirror, glass) bounce, which light sampling
+// camera, on light triangle t reached from `origin` at squared distance dist2 under
+// cos_light; bsdf_pdf < 0 marks a delta (mirror, glass) bounce, which light sampling
 // cannot reproduce, so its emission always counts.
-FH_INLINE float emission_weight(uint depth, float bsdf_pdf, float light_pdf_area, float dist2, float cos_light) {
+FH_INLINE float emission_weight(uint depth, float bsdf_pdf, __global const float4* triangles, int t,
+                                float light_pdf_area, float3 origin, float dist2, float cos_light) {
 #if defined(FH_METHOD_PT)
   return 1.0f;
 #elif defined(FH_METHOD_NEE)
   return depth == 0 || bsdf_pdf < 0.0f ? 1.0f : 0.0f;  // light sampling counted the rest
 #else
   if (depth == 0 || bsdf_pdf < 0.0f) return 1.0f;
-  return power_heuristic(bsdf_pdf, area_to_solid_angle(light_pdf_area, dist2, cos_light));
+  // The density light sampling (shadow_connect) would have had for this point.
+  const float3 v0 = triangles[3 * t].xyz, v1 = triangles[3 * t + 1].xyz, v2 = triangles[3 * t + 2].xyz;
+  const float area = 0.5f * length(cross(v1 - v0, v2 - v0));
+  const SphericalTriangle st = light_seen_from(origin, v0, v1, v2, area);
+  return power_heuristic(bsdf_pdf, light_pdf(&st, light_pdf_area * area, area, dist2, cos_light));
 #endif
 }
 
@@ -67,7 +73,8 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
       // connects from, so the two strategies weigh the same paths.
       const float3 ke = vload3(0, m->ke);
       if (cos_front > 0.0f && (ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f))
-        gathered += beta.xyz * ke * emission_weight(bounce, beta.w, light_pdf_area[t], h.x * h.x, cos_front);
+        gathered += beta.xyz * ke * emission_weight(bounce, beta.w, triangles, t, light_pdf_area[t], ray_org[p].xyz,
+                                                    h.x * h.x, cos_front);
 
 #if defined(FH_SHADING_NORMALS)
       const float3 ns = shading_normal(normals, t, h.y, h.z, s.normal);
@@ -95,20 +102,19 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
 
       if (may_bounce) {
         const uint dim = bounce * FH_DIMS_PER_BOUNCE;
-        const uint rng = rng_stream(params.seed, sample_id[p]);
+        const PixelSampler sampler = pixel_sampler(params.seed, sample_id[p], params.pixel_count);
+        const float2 u = sample_2d(&sampler, dim + FH_DIM_BSDF_U1);
         float3 wi;
         float pdf;
         const float3 weight =
-            bsdf_sample(&bsdf, s.normal, ns, wo, random_in_stream(rng, dim + FH_DIM_BSDF_LOBE),
-                        random_in_stream(rng, dim + FH_DIM_BSDF_U1), random_in_stream(rng, dim + FH_DIM_BSDF_U2),
-                        &wi, &pdf);
+            bsdf_sample(&bsdf, s.normal, ns, wo, sample_1d(&sampler, dim + FH_DIM_BSDF_LOBE), u.x, u.y, &wi, &pdf);
         beta = (float4)(beta.xyz * weight, pdf);
         continues = pdf != 0.0f;
         // Russian roulette: survive with a probability from the throughput (capped, so
         // bright paths still end); dividing by it keeps the estimator unbiased.
         if (continues && bounce + 1 >= params.rr_depth) {
           const float survive = fmin(fmax(fmax(beta.x, beta.y), beta.z), 0.95f);
-          if (random_in_stream(rng, dim + FH_DIM_ROULETTE) >= survive) continues = false;
+          if (sample_1d(&sampler, dim + FH_DIM_ROULETTE) >= survive) continues = false;
           else beta.xyz /= survive;
         }
         continues = continues && (beta.x > 0.0f || beta.y > 0.0f || beta.z > 0.0f);

@@ -1,13 +1,13 @@
 // The shadow-connect stage: next-event estimation for each light-sample request that
-// shade queued. Picks an emissive triangle in proportion to its power and a uniform point
-// on it (the area formulation: G(x,y) and V(x,y)), traces the shadow ray, and adds the
-// unoccluded contribution, weighted against BSDF sampling for mis.
+// shade queued. Picks an emissive triangle in proportion to its power and a point on it
+// (uniform in the solid angle it subtends, or in area: lights.h), traces the shadow ray
+// (V(x,y)), and adds the unoccluded contribution, weighted against BSDF sampling for mis.
 #include "bsdf.h"
 #include "intersect.h"
 #include "lights.h"
 #include "path_state.h"
 #include "ray.h"
-#include "rng.h"
+#include "sampler.h"
 #include "sampling.h"
 
 __kernel void shadow_connect(RenderParams params, volatile __global uint* counters,
@@ -26,17 +26,23 @@ __kernel void shadow_connect(RenderParams params, volatile __global uint* counte
   s.normal = shadow_geometric[i].xyz;  // the geometric normal on the viewer's side
   const float3 n = normal.xyz;          // the shading normal, same side
   const float4 beta = shadow_throughput[i];  // w: the bounce count at the shading point
-  const uint rng = rng_stream(params.seed, sample_id[p]), dim = (uint)as_int(beta.w) * FH_DIMS_PER_BOUNCE;
+  const PixelSampler sampler = pixel_sampler(params.seed, sample_id[p], params.pixel_count);
+  const uint dim = (uint)as_int(beta.w) * FH_DIMS_PER_BOUNCE;
 
-  const uint light = pick_light(light_cdf, params.light_count, random_in_stream(rng, dim + FH_DIM_LIGHT_PICK));
-  const int lt = light_triangle[light];
-  const float2 b = sample_triangle(random_in_stream(rng, dim + FH_DIM_LIGHT_U1),
-                                   random_in_stream(rng, dim + FH_DIM_LIGHT_U2));
-  const SurfacePoint l = surface_point(triangles, lt, b.x, b.y);
   // Connect from the point just off the surface that BSDF-sampled rays also start from:
   // both strategies then see the same geometry, and their MIS weights sum to one even
   // where the offset is a visible distance (far from the origin).
   const float3 origin = offset_ray_origin(&s, s.normal);
+  const uint light = pick_light(light_cdf, params.light_count, sample_1d(&sampler, dim + FH_DIM_LIGHT_PICK));
+  const int lt = light_triangle[light];
+  const float3 v0 = triangles[3 * lt].xyz, v1 = triangles[3 * lt + 1].xyz, v2 = triangles[3 * lt + 2].xyz;
+  const float area = 0.5f * length(cross(v1 - v0, v2 - v0));
+  const SphericalTriangle st = light_seen_from(origin, v0, v1, v2, area);
+  const float2 u = sample_2d(&sampler, dim + FH_DIM_LIGHT_U1);
+  const float2 b = st.solid_angle > 0.0f
+                       ? barycentrics_along(origin, sample_spherical_triangle(&st, u.x, u.y), v0, v1, v2)
+                       : sample_triangle(u.x, u.y);
+  const SurfacePoint l = surface_point(triangles, lt, b.x, b.y);
   const float3 to_light = l.position - origin;
   const float dist2 = dot(to_light, to_light);
   if (!(dist2 > 0.0f)) return;
@@ -49,7 +55,7 @@ __kernel void shadow_connect(RenderParams params, volatile __global uint* counte
   bsdf.kd = shadow_albedo[i].xyz;  // textured or not, as shade found it
   const float3 wo = shadow_wo[i].xyz;
   const float3 f = bsdf_eval(&bsdf, n, wo, wi);
-  const float pdf_light = area_to_solid_angle(light_pdf_area[lt], dist2, cos_light);
+  const float pdf_light = light_pdf(&st, light_pdf_area[lt] * area, area, dist2, cos_light);
 #if defined(FH_METHOD_MIS)
   const float weight = power_heuristic(pdf_light, bsdf_pdf(&bsdf, n, wo, wi));
 #else

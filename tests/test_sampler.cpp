@@ -1,0 +1,108 @@
+// The pixel sampler on the device (kernels/sampler.h): a pixel's first 2^k samples of a 2D
+// dimension form a (0,k,2)-net (one point in every elementary interval of area 2^-k) and
+// those of a 1D dimension one point per interval of length 2^-k; a given sample, across
+// pixels, is uniform (chi-square); dimension pairs and seeds are uncorrelated.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "kernel_sources.h"
+#include "program.h"
+#include "ray_caster.h"
+#include "test_support.h"
+
+namespace fh {
+namespace {
+
+const char* kTestKernels = R"CL(
+__kernel void draw(uint seed, uint pixel_count, uint dimension, uint one_d, __global float2* out) {
+  const uint i = get_global_id(0);
+  const PixelSampler s = pixel_sampler(seed, i, pixel_count);
+  out[i] = one_d ? (float2)(sample_1d(&s, dimension), 0.0f) : sample_2d(&s, dimension);
+}
+)CL";
+
+class PixelSamplerOnDevice : public ::testing::Test {
+ protected:
+  DeviceContext dc{selectDevices(listDevices(), "").front()};
+  cl::Program program =
+      buildProgramFromSource(dc.context, dc.info.device, assembleKernelSources({"sampler.h"}) + kTestKernels, "");
+
+  // Samples 0 .. passes-1 of every pixel: result[pass * pixels + pixel].
+  std::vector<float> draw(unsigned seed, unsigned pixels, unsigned passes, unsigned dimension, bool oneD = false) {
+    const size_t n = size_t(pixels) * passes;
+    cl::Buffer out = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, n * 8, "samples");
+    cl::Kernel k = createKernel(program, "draw");
+    setKernelArgs(k, seed, pixels, dimension, cl_uint(oneD), out);
+    FH_CL(dc.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n), cl::NDRange(64)));
+    std::vector<float> v(n * 2);
+    FH_CL(dc.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * 8, v.data()));
+    return v;
+  }
+};
+
+TEST_F(PixelSamplerOnDevice, EveryPowerOfTwoPrefixIsANet) {
+  const unsigned pixels = 64, passes = 256;
+  for (unsigned dimension : {0u, 4u, 13u, 0x7fff0000u}) {
+    const std::vector<float> v = draw(7, pixels, passes, dimension);
+    const std::vector<float> w = draw(7, pixels, passes, dimension, true);
+    for (unsigned pixel : {0u, 1u, 37u, 63u})
+      for (unsigned k : {2u, 4u, 6u, 8u}) {
+        const unsigned n = 1u << k;
+        for (unsigned a = 0; a <= k; ++a) {  // cells of 2^-a by 2^-(k - a)
+          std::set<unsigned> cells;
+          for (unsigned s = 0; s < n; ++s) {
+            const size_t i = 2 * (size_t(s) * pixels + pixel);
+            cells.insert(unsigned(v[i] * float(1u << a)) * (1u << (k - a)) + unsigned(v[i + 1] * float(1u << (k - a))));
+          }
+          EXPECT_EQ(cells.size(), n) << "dimension " << dimension << " pixel " << pixel << " 2^" << k << " split " << a;
+        }
+        std::set<unsigned> intervals;
+        for (unsigned s = 0; s < n; ++s) intervals.insert(unsigned(w[2 * (size_t(s) * pixels + pixel)] * float(n)));
+        EXPECT_EQ(intervals.size(), n) << "1D dimension " << dimension << " pixel " << pixel << " 2^" << k;
+      }
+  }
+}
+
+// Each sample index, over many pixels, is uniform in the square: the scrambling is random
+// per pixel, which is what keeps the estimator unbiased.
+TEST_F(PixelSamplerOnDevice, EachSampleIsUniformAcrossPixels) {
+  const unsigned pixels = 16384, passes = 5, grid = 16;
+  const std::vector<float> v = draw(3, pixels, passes, 8);
+  for (unsigned pass = 0; pass < passes; ++pass) {
+    std::vector<double> count(grid * grid, 0.0);
+    for (unsigned p = 0; p < pixels; ++p) {
+      const size_t i = 2 * (size_t(pass) * pixels + p);
+      count[unsigned(v[i] * grid) * grid + unsigned(v[i + 1] * grid)] += 1.0;
+    }
+    const double expected = double(pixels) / (grid * grid);
+    double chi2 = 0;
+    for (double c : count) chi2 += (c - expected) * (c - expected) / expected;
+    // 255 degrees of freedom: mean 255, sd 22.6; the bound is about p = 1e-4.
+    EXPECT_LT(chi2, 255 + 3.9 * std::sqrt(2 * 255.0)) << "pass " << pass;
+  }
+}
+
+// Two dimension pairs of one pixel (shuffled independently), and one dimension under two
+// seeds, are uncorrelated: |r| below 4 standard errors of a zero correlation.
+TEST_F(PixelSamplerOnDevice, DimensionsAndSeedsAreUncorrelated) {
+  const unsigned pixels = 256, passes = 64;
+  const size_t n = size_t(pixels) * passes;
+  auto correlation = [&](const std::vector<float>& a, const std::vector<float>& b) {
+    double ma = 0, mb = 0, sab = 0, saa = 0, sbb = 0;
+    for (size_t i = 0; i < n; ++i) ma += a[2 * i] / double(n), mb += b[2 * i] / double(n);
+    for (size_t i = 0; i < n; ++i) {
+      const double da = a[2 * i] - ma, db = b[2 * i] - mb;
+      sab += da * db, saa += da * da, sbb += db * db;
+    }
+    return sab / std::sqrt(saa * sbb);
+  };
+  const double bound = 4.0 / std::sqrt(double(n));
+  EXPECT_LT(std::fabs(correlation(draw(1, pixels, passes, 0), draw(1, pixels, passes, 4))), bound);
+  EXPECT_LT(std::fabs(correlation(draw(1, pixels, passes, 0), draw(2, pixels, passes, 0))), bound);
+  EXPECT_LT(std::fabs(correlation(draw(1, pixels, passes, 2, true), draw(1, pixels, passes, 3, true))), bound);
+}
+
+}  // namespace
+}  // namespace fh
