@@ -472,8 +472,8 @@ TEST(WhereMethodsFail, LightHiddenBehindACorner) {
 
 // Large lights in near-mirror plates (the Veach MIS scene): light samples on the sharp
 // lobes are spiky, so nee's estimate is heavy-tailed: its image mean over three seeds at
-// 8192 spp (24x24) was 0.92, 0.73, 0.70 against mis's 0.761, 0.754, 0.754 and pt's 0.760,
-// 0.757, 0.755 (bench/RESULTS.md). Its sample variance then understates the true one, and
+// 8192 spp (24x24, independent random numbers) was 0.92, 0.73, 0.70 against mis's 0.761,
+// 0.754, 0.754 and pt's 0.760, 0.757, 0.755 (bench/RESULTS.md). Its sample variance then understates the true one, and
 // no z-test of nee is meaningful here; pt and mis must agree, and mis must be within 1.5x
 // of the better method's variance (pt's, here).
 TEST(WhereMethodsFail, LargeLightsInNearMirrorGlossyPlates) {
