@@ -1,13 +1,13 @@
 // Per-pixel low-discrepancy samples for the path's random decisions.
 //
-// The samples of one pixel (its passes 0, 1, 2, ...) take their 2D decisions (a BSDF
-// direction, a point on a light) from the Sobol' (0,2)-sequence in base 2 and their 1D ones
-// (lobe, roulette, light choice) from the van der Corput sequence, so that any 2^k of them
-// stratify their square or interval. Each pixel and each dimension pair gets its own random
+// The samples of one pixel (its passes 0, 1, 2, ...) take their 2D decisions (sub-pixel
+// position, BSDF direction, point on a light) from the Sobol' (0,2)-sequence in base 2 and
+// their 1D ones (lobe, roulette, light choice) from the van der Corput sequence, so that any
+// 2^k of them stratify their square or interval. Each pixel and each dimension pair gets its own random
 // Owen scrambling (every point still uniform: the estimator stays unbiased) and its own
 // shuffle of the sample order (so pairs of dimensions are not correlated with each other):
-// Burley, "Practical Hash-based Owen Scrambling", JCGT 2020, with the Laine-Karras style
-// permutation constants published by Vegdahl (2021).
+// Burley, "Practical Hash-based Owen Scrambling", JCGT 2020, with its Laine-Karras style
+// hash (owen_hash below).
 #ifndef FH_SAMPLER_H
 #define FH_SAMPLER_H
 
