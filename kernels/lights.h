@@ -104,12 +104,32 @@ FH_INLINE float2 barycentrics_along(float3 o, float3 w, float3 v0, float3 v1, fl
   return (float2)(b1, b2);
 }
 
-// The density (per solid angle at the receiver) with which light sampling picks a point
-// of a light triangle seen as t (light_seen_from): `pick` the chance of that triangle,
-// `area` its area, the point at squared distance dist2 seen under cos_light.
-FH_INLINE float light_pdf(const SphericalTriangle* t, float pick, float area, float dist2, float cos_light) {
-  if (t->solid_angle > 0.0f) return pick / t->solid_angle;
-  return area_to_solid_angle(pick / area, dist2, cos_light);
+// A light triangle as light sampling treats it from a receiver's ray origin: its corners,
+// area, the chance `pick` that light sampling chooses it, and how it is sampled from there
+// (seen.solid_angle > 0: by solid angle). shadow_connect samples with it and shade weighs
+// BSDF-found emission with it, so both use one density (light_pdf) for the same point.
+typedef struct {
+  float3 v0, v1, v2;
+  float area, pick;
+  SphericalTriangle seen;
+} LightTriangle;
+
+FH_INLINE LightTriangle light_triangle_from(__global const float4* triangles, int t, float pdf_area, float3 origin) {
+  LightTriangle l;
+  l.v0 = triangles[3 * t].xyz;
+  l.v1 = triangles[3 * t + 1].xyz;
+  l.v2 = triangles[3 * t + 2].xyz;
+  l.area = 0.5f * length(cross(l.v1 - l.v0, l.v2 - l.v0));
+  l.pick = pdf_area * l.area;  // pdf_area = P(triangle) / area
+  l.seen = light_seen_from(origin, l.v0, l.v1, l.v2, l.area);
+  return l;
+}
+
+// The density (per solid angle at the receiver) with which light sampling picks a point of
+// light triangle l at squared distance dist2, seen under cos_light.
+FH_INLINE float light_pdf(const LightTriangle* l, float dist2, float cos_light) {
+  if (l->seen.solid_angle > 0.0f) return l->pick / l->seen.solid_angle;
+  return area_to_solid_angle(l->pick / l->area, dist2, cos_light);
 }
 
 // The power heuristic (beta = 2) weight of a sample drawn with density `a` against `b`.

@@ -17,15 +17,10 @@ FH_INLINE uint hash_combine(uint a, uint b) { return hash_u32(a ^ (b + 0x9e3779b
 // A float in [0, 1) from the top 24 bits.
 FH_INLINE float u32_to_unit_float(uint x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
 
-// One stream of numbers per (seed, stream), e.g. per sample: hash it once per kernel and
-// draw its dimensions with random_in_stream.
-FH_INLINE uint rng_stream(uint seed, uint stream) { return hash_combine(seed, stream); }
-FH_INLINE float random_in_stream(uint stream, uint dimension) {
-  return u32_to_unit_float(hash_combine(stream, dimension));
-}
-
+// Independent uniform numbers per (seed, stream, dimension), for the bench's ray batches
+// and the debug views; the path tracer draws its decisions from sampler.h.
 FH_INLINE float random_float(uint seed, uint stream, uint dimension) {
-  return random_in_stream(rng_stream(seed, stream), dimension);
+  return u32_to_unit_float(hash_combine(hash_combine(seed, stream), dimension));
 }
 
 #endif

@@ -28,10 +28,8 @@ FH_INLINE float emission_weight(uint depth, float bsdf_pdf, __global const float
 #else
   if (depth == 0 || bsdf_pdf < 0.0f) return 1.0f;
   // The density light sampling (shadow_connect) would have had for this point.
-  const float3 v0 = triangles[3 * t].xyz, v1 = triangles[3 * t + 1].xyz, v2 = triangles[3 * t + 2].xyz;
-  const float area = 0.5f * length(cross(v1 - v0, v2 - v0));
-  const SphericalTriangle st = light_seen_from(origin, v0, v1, v2, area);
-  return power_heuristic(bsdf_pdf, light_pdf(&st, light_pdf_area * area, area, dist2, cos_light));
+  const LightTriangle light = light_triangle_from(triangles, t, light_pdf_area, origin);
+  return power_heuristic(bsdf_pdf, light_pdf(&light, dist2, cos_light));
 #endif
 }
 

@@ -35,12 +35,11 @@ __kernel void shadow_connect(RenderParams params, volatile __global uint* counte
   const float3 origin = offset_ray_origin(&s, s.normal);
   const uint light = pick_light(light_cdf, params.light_count, sample_1d(&sampler, dim + FH_DIM_LIGHT_PICK));
   const int lt = light_triangle[light];
-  const float3 v0 = triangles[3 * lt].xyz, v1 = triangles[3 * lt + 1].xyz, v2 = triangles[3 * lt + 2].xyz;
-  const float area = 0.5f * length(cross(v1 - v0, v2 - v0));
-  const SphericalTriangle st = light_seen_from(origin, v0, v1, v2, area);
+  const LightTriangle light_tri = light_triangle_from(triangles, lt, light_pdf_area[lt], origin);
   const float2 u = sample_2d(&sampler, dim + FH_DIM_LIGHT_U1);
-  const float2 b = st.solid_angle > 0.0f
-                       ? barycentrics_along(origin, sample_spherical_triangle(&st, u.x, u.y), v0, v1, v2)
+  const float2 b = light_tri.seen.solid_angle > 0.0f
+                       ? barycentrics_along(origin, sample_spherical_triangle(&light_tri.seen, u.x, u.y), light_tri.v0,
+                                            light_tri.v1, light_tri.v2)
                        : sample_triangle(u.x, u.y);
   const SurfacePoint l = surface_point(triangles, lt, b.x, b.y);
   const float3 to_light = l.position - origin;
@@ -55,7 +54,7 @@ __kernel void shadow_connect(RenderParams params, volatile __global uint* counte
   bsdf.kd = shadow_albedo[i].xyz;  // textured or not, as shade found it
   const float3 wo = shadow_wo[i].xyz;
   const float3 f = bsdf_eval(&bsdf, n, wo, wi);
-  const float pdf_light = light_pdf(&st, light_pdf_area[lt] * area, area, dist2, cos_light);
+  const float pdf_light = light_pdf(&light_tri, dist2, cos_light);
 #if defined(FH_METHOD_MIS)
   const float weight = power_heuristic(pdf_light, bsdf_pdf(&bsdf, n, wo, wi));
 #else
