@@ -81,17 +81,21 @@ FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8
   // Compare t against the interval without dividing: flip by det's sign.
   const float8 abs_det = fabs(det);
   const float8 ts = select(t_scaled, -t_scaled, det < zero);
-  const int8 valid = ~outside & (det != zero) & (ts >= t_min * abs_det) & (ts < *t_max * abs_det);
+  const int8 maybe = ~outside & (det != zero) & (ts >= t_min * abs_det) & (ts < *t_max * abs_det);
+  if (!any(maybe)) return -1;
+  // The products above round differently from the quotient below: a lane can pass them
+  // and still have t >= t_max (a triangle at the current hit's distance, duplicated or
+  // across a shared edge). Accept only on the quotient, the value the hit keeps.
+  const float8 quotient = t_scaled / det;
+  const int8 valid = maybe & (quotient >= (float8)(t_min)) & (quotient < (float8)(*t_max));
   if (!any(valid)) return -1;
-  const float8 t = select((float8)(INFINITY), t_scaled / det, valid);
+  const float8 t = select((float8)(INFINITY), quotient, valid);
   float lanes[8];
   vstore8(t, 0, lanes);
-  int best = -1;
-  for (int i = 0; i < 8; ++i)
-    if (lanes[i] < *t_max) {
-      *t_max = lanes[i];
-      best = i;
-    }
+  int best = 0;
+  for (int i = 1; i < 8; ++i)
+    if (lanes[i] < lanes[best]) best = i;
+  *t_max = lanes[best];
   float vs[8], ws[8], ds[8];
   vstore8(v, 0, vs);
   vstore8(w, 0, ws);

@@ -46,6 +46,22 @@ double tTolerance(const Scene& scene, size_t triangle, const float* org, const f
   return 1e-5 * (magnitude(org) + t) / std::max(cosine, 1e-4) + 1e-30;
 }
 
+// Distance between the point the device's barycentrics name on `triangle` and the
+// reference hit point org + tRef * dir, in double.
+double hitPointError(const Scene& scene, size_t triangle, float b1, float b2, const double org[3],
+                     const double dir[3], double tRef) {
+  double err = 0.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double v0 = scene.corner(triangle, 0)[axis], v1 = scene.corner(triangle, 1)[axis],
+                 v2 = scene.corner(triangle, 2)[axis];
+    const double onTriangle = v0 * (1.0 - double(b1) - double(b2)) + v1 * double(b1) + v2 * double(b2);
+    const double onRay = org[axis] + tRef * dir[axis];
+    const double e = std::fabs(onTriangle - onRay);
+    if (!(e <= err)) err = e;  // NaN stays NaN (std::max would drop it)
+  }
+  return err;
+}
+
 struct Mismatch {
   size_t ray;
   std::string what;
@@ -70,8 +86,12 @@ std::vector<Mismatch> checkRays(const Scene& scene, const Bvh& bvh, const Rays& 
       const size_t tri = bvh.order[size_t(bvhTri)];
       const double tRef = test::rayTriangleWithMargin(scene, tri, org, dir, test::floatEdgeMargin(scene, tri, org));
       const double tol = tTolerance(scene, tri, o, d, tRef);
+      const double pointError = hitPointError(scene, tri, hits[4 * i + 1], hits[4 * i + 2], org, dir, tRef);
       if (!(std::fabs(t - tRef) <= tol))
         why << "device hit triangle " << tri << " at t=" << t << ", reference t for it " << tRef;
+      else if (!(pointError <= tol * length(float3{d[0], d[1], d[2]})))
+        why << "device barycentrics (" << hits[4 * i + 1] << ", " << hits[4 * i + 2] << ") on triangle " << tri
+            << " name a point " << pointError << " from the reference hit";
       else if (ref.shrunk.t < t - tol)
         why << "device hit triangle " << tri << " at t=" << t << " but triangle " << ref.shrunk.triangle
             << " is closer at " << ref.shrunk.t;
@@ -351,6 +371,62 @@ TEST(Watertight, RaysAtSharedEdgesAndVerticesNeverMiss) {
     EXPECT_EQ(rc.lastHitFraction, 1.0) << "rays from inside a closed mesh escaped: " << name;
     rc.expectMatchesReference(outside, "outside, " + name);
     EXPECT_EQ(rc.lastHitFraction, 1.0) << "rays at front-facing edges and vertices missed: " << name;
+  }
+}
+
+// Triangles at exactly the current hit's distance in a later leaf (duplicated faces, as in
+// the archive's Cornell box, or overlapping ones) must leave the hit and its barycentrics
+// as they were: a lane that passes the division-free interval test but whose quotient t
+// equals t_max once selected no lane, and the kernel read its barycentrics from index -1.
+TEST(CoincidentTriangles, HitsKeepTheirOwnTriangleAndBarycentrics) {
+  // A slanted quad copied twelve times (more than one leaf holds), and a grid of slanted
+  // quads whose shared edges cross leaves.
+  Scene copies;
+  copies.materials.push_back(Material{});
+  const float3 quad[4] = {{-1.f, -0.7f, 0.3f}, {1.2f, -0.9f, -0.4f}, {0.9f, 1.1f, -0.2f}, {-1.1f, 0.8f, 0.5f}};
+  for (int copy = 0; copy < 12; ++copy) {
+    const unsigned base = unsigned(copies.vertexCount());
+    for (const float3& p : quad) copies.positions.insert(copies.positions.end(), p.begin(), p.end());
+    for (unsigned k : {0u, 1u, 2u, 0u, 2u, 3u}) copies.indices.push_back(base + k);
+    copies.triangleMaterial.insert(copies.triangleMaterial.end(), {0, 0});
+  }
+  Scene grid;
+  grid.materials.push_back(Material{});
+  const int cells = 24;
+  auto gridPoint = [&](int i, int j) {
+    const float x = -1.f + 2.f * float(i) / cells, y = -1.f + 2.f * float(j) / cells;
+    return float3{x, y, 0.37f * x - 0.21f * y + 0.05f * x * y};
+  };
+  for (int i = 0; i < cells; ++i)
+    for (int j = 0; j < cells; ++j) {
+      const unsigned base = unsigned(grid.vertexCount());
+      for (const float3& p : {gridPoint(i, j), gridPoint(i + 1, j), gridPoint(i + 1, j + 1), gridPoint(i, j + 1)})
+        grid.positions.insert(grid.positions.end(), p.begin(), p.end());
+      for (unsigned k : {0u, 1u, 2u, 0u, 2u, 3u}) grid.indices.push_back(base + k);
+      grid.triangleMaterial.insert(grid.triangleMaterial.end(), {0, 0});
+    }
+
+  for (const Scene* scene : {&copies, &grid}) {
+    RayCasting rc(*scene);
+    Rays rays;
+    std::mt19937 rng(29);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    for (int i = 0; i < 4096; ++i) {
+      // Aimed at a random point, a vertex or a point on an edge, from either side.
+      const size_t t = size_t(i) % scene->triangleCount();
+      const int k = i % 3;
+      const float a = u(rng), b = u(rng);
+      float3 target;
+      switch ((i / 3) % 3) {
+        case 0: target = pointOnTriangle(*scene, t, a * (1.f - b), b * (1.f - a)); break;
+        case 1: target = scene->corner(t, k); break;
+        default: target = scene->corner(t, k) * (1.f - a) + scene->corner(t, (k + 1) % 3) * a; break;
+      }
+      const float3 from = target + randomDirection(rng) * (0.5f + 3.f * u(rng));
+      rays.add(from, normalize(target - from));
+    }
+    rc.expectMatchesReference(rays, scene == &copies ? "twelve copies of a quad" : "grid of shared edges");
+    EXPECT_GT(rc.lastHitFraction, 0.6);  // rays at the border of the mesh may miss
   }
 }
 
