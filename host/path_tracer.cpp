@@ -153,6 +153,15 @@ std::string statsJson(const RenderStats& st, const RenderSettings& s) {
   return doc.dump(2);
 }
 
+ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsigned passSlots,
+                              const std::string& traversalOptions) {
+  const char* methodFlag = method == Method::PT ? "PT" : method == Method::NEE ? "NEE" : "MIS";
+  return {std::string("path tracer (") + methodName(method) + features.buildOptions() + ")",
+          {"generate.cl", "intersect.cl", "shade.cl", "shadow_connect.cl", "accumulate.cl"},
+          traversalOptions + features.buildOptions() + " -DFH_PASS_SLOTS=" + std::to_string(passSlots) +
+              " -DFH_METHOD_" + methodFlag};
+}
+
 size_t defaultWavefront(const DeviceInfo& device, size_t pixels) {
   const size_t preferred = device.type == "gpu" ? (size_t(1) << 20) : (size_t(1) << 16);
   return std::max<size_t>(kLocalSize, std::min(preferred, 2 * pixels));
@@ -178,13 +187,9 @@ PathTracer::PathTracer(DeviceContext& dc, const Scene& scene, const Bvh& bvh, co
   // Enough passes in flight that the wavefront stays full while a pass's longest paths
   // finish: pass buffers cost a frame each, so only as many as the wavefront needs.
   passSlots_ = unsigned(std::min<size_t>(FH_MAX_PASS_SLOTS, 2 + (2 * wavefront_ + pixels_ - 1) / pixels_));
-  const std::string options = scene_.caster.traversalOptions() + scene_.features.buildOptions() +
-                              " -DFH_PASS_SLOTS=" + std::to_string(passSlots_) +
-                              " -DFH_METHOD_" +
-                              (s.method == Method::PT ? "PT" : s.method == Method::NEE ? "NEE" : "MIS");
-  const cl::Program program =
-      buildProgram(dc.context, dc.info.device,
-                   {"generate.cl", "intersect.cl", "shade.cl", "shadow_connect.cl", "accumulate.cl"}, options);
+  const cl::Program program = buildProgram(
+      dc.context, dc.info.device,
+      pathTracerProgram(scene_.features, s.method, passSlots_, scene_.caster.traversalOptions()));
   plan_ = createKernel(program, "plan_iteration");
   generate_ = createKernel(program, "generate_paths");
   intersect_ = createKernel(program, "intersect_paths");

@@ -167,10 +167,16 @@ std::string programCacheDir() {
   return "";
 }
 
+std::string extraBuildOptions() {
+  const char* extra = std::getenv("FREDHOLM_CL_OPTIONS");
+  return extra && *extra ? std::string(" ") + extra : "";
+}
+
 cl::Program buildProgramFromSource(const cl::Context& context, const cl::Device& device,
-                                   const std::string& source, const std::string& options,
+                                   const std::string& source, const std::string& programOptions,
                                    ProgramBuildInfo* info) {
   const auto start = std::chrono::steady_clock::now();
+  const std::string options = programOptions + extraBuildOptions();
   const std::string dir = programCacheDir();
   const std::string path = dir.empty() ? "" : dir + "/" + cacheKey(device, source, options) + ".bin";
   cl::Program program;
@@ -194,6 +200,11 @@ cl::Program buildProgram(const cl::Context& context, const cl::Device& device,
                          const std::vector<std::string>& files, const std::string& options,
                          ProgramBuildInfo* info) {
   return buildProgramFromSource(context, device, assembleKernelSources(files), options, info);
+}
+
+cl::Program buildProgram(const cl::Context& context, const cl::Device& device, const ProgramSpec& spec,
+                         ProgramBuildInfo* info) {
+  return buildProgram(context, device, spec.files, spec.options, info);
 }
 
 cl::Kernel createKernel(const cl::Program& program, const char* name) {

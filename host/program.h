@@ -18,6 +18,18 @@ struct ProgramBuildInfo {
 // else ~/.cache/fredholm. Empty when none can be determined.
 std::string programCacheDir();
 
+// One OpenCL program: the kernel files it is assembled from and the options that select
+// its variant. Each module declares its programs once (see everyProgramVariant).
+struct ProgramSpec {
+  std::string name;
+  std::vector<std::string> files;
+  std::string options;
+};
+
+// Options appended to every program build: $FREDHOLM_CL_OPTIONS (e.g. -cl-opt-disable for
+// a portability check or a simulator that cannot run optimised code), else nothing.
+std::string extraBuildOptions();
+
 // Builds `files` (names under kernels/) for one device. A compile failure throws
 // fh::BuildError whose message holds the device's build log.
 cl::Program buildProgram(const cl::Context& context, const cl::Device& device,
@@ -28,6 +40,9 @@ cl::Program buildProgram(const cl::Context& context, const cl::Device& device,
 cl::Program buildProgramFromSource(const cl::Context& context, const cl::Device& device,
                                    const std::string& source, const std::string& options,
                                    ProgramBuildInfo* info = nullptr);
+
+cl::Program buildProgram(const cl::Context& context, const cl::Device& device, const ProgramSpec& spec,
+                         ProgramBuildInfo* info = nullptr);
 
 cl::Kernel createKernel(const cl::Program& program, const char* name);
 

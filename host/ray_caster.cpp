@@ -18,6 +18,10 @@ void launch(const DeviceContext& dc, const cl::Kernel& kernel, size_t count, con
   FH_CL_ERR(err, (std::string("clEnqueueNDRangeKernel(") + name + ")").c_str());
 }
 
+ProgramSpec intersectProgram(const std::string& traversalOptions) {
+  return {"intersect", {"intersect.cl"}, traversalOptions};
+}
+
 RayCaster::RayCaster(DeviceContext& dc, const Bvh& bvh) : dc_(dc) {
   options_ = "-DFH_TRAVERSAL_STACK=" + std::to_string(bvh.traversalStack());
   nodes_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, bvh.nodes.size() * sizeof(gpu::Bvh8Node),
@@ -26,7 +30,7 @@ RayCaster::RayCaster(DeviceContext& dc, const Bvh& bvh) : dc_(dc) {
                            bvh.blocks.size() * sizeof(gpu::TriangleBlock8), "BVH leaf triangles", bvh.blocks.data());
   triangles_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, bvh.triangles.size() * sizeof(float),
                               "triangles", bvh.triangles.data());
-  const cl::Program program = buildProgram(dc.context, dc.info.device, {"intersect.cl"}, options_, &buildInfo_);
+  const cl::Program program = buildProgram(dc.context, dc.info.device, intersectProgram(options_), &buildInfo_);
   closest_ = createKernel(program, "intersect_closest");
   any_ = createKernel(program, "intersect_any");
 }

@@ -26,6 +26,9 @@ constexpr size_t kLocalSize = 64;
 void launch(const DeviceContext& dc, const cl::Kernel& kernel, size_t count, const char* name,
             cl::Event* event = nullptr);
 
+// The intersect kernels for a BVH that needs `traversalOptions` (its stack depth).
+ProgramSpec intersectProgram(const std::string& traversalOptions);
+
 class RayCaster {
  public:
   RayCaster(DeviceContext& dc, const Bvh& bvh);

@@ -5,10 +5,13 @@
 
 namespace fh {
 
+ProgramSpec benchRaysProgram(const std::string& traversalOptions) {
+  return {"bench rays", {"generate.cl", "bench_rays.cl"}, traversalOptions};
+}
+
 RayWorkload::RayWorkload(DeviceContext& dc, const Scene& scene, const Bvh& bvh, RayCaster& caster)
     : dc_(dc), caster_(caster) {
-  const cl::Program program =
-      buildProgram(dc.context, dc.info.device, {"generate.cl", "bench_rays.cl"}, caster.traversalOptions());
+  const cl::Program program = buildProgram(dc.context, dc.info.device, benchRaysProgram(caster.traversalOptions()));
   generate_ = createKernel(program, "generate_camera_rays");
   bounce_ = createKernel(program, "spawn_bounce_rays");
   shadow_ = createKernel(program, "spawn_shadow_rays");

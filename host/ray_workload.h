@@ -16,6 +16,9 @@ struct RayQueue {
   unsigned count = 0;
 };
 
+// The kernels that make those batches.
+ProgramSpec benchRaysProgram(const std::string& traversalOptions);
+
 class RayWorkload {
  public:
   RayWorkload(DeviceContext& dc, const Scene& scene, const Bvh& bvh, RayCaster& caster);

@@ -26,9 +26,11 @@ gpu::CameraParams makeCameraParams(const Camera& camera, int width, int height) 
   return p;
 }
 
+ProgramSpec aovProgram() { return {"aov", {"generate.cl", "aov.cl"}, ""}; }
+
 Image renderAov(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const Camera& camera, const AovSettings& s) {
   RayCaster caster(dc, bvh);
-  const cl::Program program = buildProgram(dc.context, dc.info.device, {"generate.cl", "aov.cl"}, "");
+  const cl::Program program = buildProgram(dc.context, dc.info.device, aovProgram());
   cl::Kernel generate = createKernel(program, "generate_camera_rays");
   cl::Kernel shade = createKernel(program, "shade_aov");
 

@@ -23,6 +23,8 @@ struct AovSettings {
   Aov mode = Aov::Albedo;
 };
 
+ProgramSpec aovProgram();
+
 gpu::CameraParams makeCameraParams(const Camera& camera, int width, int height);
 
 Image renderAov(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const Camera& camera, const AovSettings& s);

@@ -44,8 +44,9 @@ FH_INLINE Bsdf material_bsdf(__global const GpuMaterial* m) {
   b.eta = m->tf[3] > 0.0f ? m->tf[3] : 1.5f;
   b.alpha = fmax(roughness_from_ns(ns), 1e-3f);
   b.ks = ks;
+#if defined(FH_GLASS) || defined(FH_GLOSSY)
   const int illum = m->illum;
-  const bool has_specular = ks.x > 0.0f || ks.y > 0.0f || ks.z > 0.0f;
+#endif
 #if defined(FH_GLASS)
   if (illum == 4 || illum == 6 || illum == 7 || illum == 9) {
     b.lobes = FH_LOBE_GLASS;
@@ -57,6 +58,7 @@ FH_INLINE Bsdf material_bsdf(__global const GpuMaterial* m) {
   b.kd = kd;
   b.lobes = FH_LOBE_DIFFUSE;
 #if defined(FH_GLOSSY)
+  const bool has_specular = ks.x > 0.0f || ks.y > 0.0f || ks.z > 0.0f;
   if (has_specular && illum >= 2)
     b.lobes |= (illum == 3 || illum == 5 || illum == 8) && ns >= FH_NS_MIRROR ? FH_LOBE_MIRROR : FH_LOBE_GLOSSY;
 #endif

@@ -79,9 +79,6 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
 #else
       const float3 ns = s.normal;
 #endif
-      // Two-sided shading for opaque surfaces: the normals on the viewer's side.
-      const float3 g = cos_front >= 0.0f ? s.normal : -s.normal;
-      const float3 n = cos_front >= 0.0f ? ns : -ns;
       const bool may_bounce = bounce + 1 <= params.max_depth;
       Bsdf bsdf = material_bsdf(m);
 #if defined(FH_TEXTURES)
@@ -89,6 +86,9 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
 #endif
 
 #if !defined(FH_METHOD_PT)
+      // Two-sided shading for opaque surfaces: the normals on the viewer's side.
+      const float3 g = cos_front >= 0.0f ? s.normal : -s.normal;
+      const float3 n = cos_front >= 0.0f ? ns : -ns;
       light_sample = may_bounce && params.light_count > 0 && bsdf_has_smooth_lobe(&bsdf);
       request_position = (float4)(s.position, s.magnitude);
       request_normal = (float4)(n, as_float(material_id));

@@ -5,8 +5,17 @@
 
 #ifdef __OPENCL_VERSION__
 // Device helpers must be inlined into the kernels: PoCL's LLVM leaves larger ones out of
-// line, and then passes rays, stacks and hits through memory (measured: 20-40 % slower).
-#define FH_INLINE inline __attribute__((always_inline))
+// line, and then passes rays, stacks and hits through memory (slower; see RESULTS).
+// `static` matters: OpenCL C follows C99's inline rules, under which a plain `inline`
+// function has no external definition, so a compiler that does not inline it (optimisation
+// off, or always_inline taken as a hint) would leave it undefined at link time.
+// FH_NO_FORCED_INLINE leaves inlining to the compiler, as a simulator (Oclgrind) needs
+// and as a compiler that takes always_inline as a hint would do.
+#ifdef FH_NO_FORCED_INLINE
+#define FH_INLINE static inline
+#else
+#define FH_INLINE static inline __attribute__((always_inline))
+#endif
 #endif
 
 #ifndef __OPENCL_VERSION__

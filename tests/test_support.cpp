@@ -10,6 +10,8 @@
 #include <fstream>
 #include <vector>
 
+#include "image_io.h"
+
 namespace fh::test {
 namespace fs = std::filesystem;
 
@@ -53,7 +55,47 @@ void writeFile(const std::string& path, const std::string& text) {
 }
 
 CommandResult runFredholm(const std::string& args, const std::string& env) {
-  const std::string command = env + " " + FREDHOLM_BINARY + " " + args + " 2>&1";
+  return runCommand(env + " " + FREDHOLM_BINARY + " " + args);
+}
+
+std::string writeFeatureScene(const std::string& dir) {
+  Image texture;
+  texture.width = texture.height = 4;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x)
+      for (int c = 0; c < 3; ++c) texture.rgb.push_back(((x + y) % 2 ? 0.8f : 0.2f) * (c == y % 3 ? 1.f : 0.6f));
+  writeImage(dir + "/checker.png", texture, {});
+  writeFile(dir + "/features.mtl",
+            "newmtl textured\nKd 1 1 1\nmap_Kd checker.png\n"
+            "newmtl glossy\nillum 2\nKd 0.3 0.3 0.5\nKs 0.4 0.4 0.4\nNs 80\n"
+            "newmtl mirror\nillum 3\nKd 0 0 0\nKs 0.9 0.9 0.9\nNs 2000\n"
+            "newmtl glass\nillum 7\nKd 0 0 0\nKs 1 1 1\nNi 1.5\nTf 1 1 1\n"
+            "newmtl smooth\nKd 0.6 0.5 0.4\n"
+            "newmtl light\nKd 0 0 0\nKe 8 8 8\n");
+  writeFile(dir + "/features.obj",
+            "mtllib features.mtl\n"
+            // Floor (y = 0, textured), back wall (z = -1, glossy), left wall (x = -1, mirror),
+            // right wall (x = 1, shading normals), ceiling light (y = 2, facing down).
+            "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\n"
+            "v -1 2 -1\nv 1 2 -1\nv 1 2 1\nv -1 2 1\n"
+            "v -0.3 1.99 -0.3\nv 0.3 1.99 -0.3\nv 0.3 1.99 0.3\nv -0.3 1.99 0.3\n"
+            // A glass tetrahedron on the floor.
+            "v -0.4 0.01 0.1\nv 0.2 0.01 0.3\nv -0.1 0.01 -0.4\nv -0.1 0.6 0\n"
+            "vt 0 0\nvt 2 0\nvt 2 2\nvt 0 2\n"
+            "vn -0.9 0.3 0\nvn -1 0 0.2\nvn -0.8 -0.2 0.1\n"
+            "usemtl textured\nf 4/4 3/3 2/2 1/1\n"
+            "usemtl glossy\nf 1 2 6 5\n"
+            "usemtl mirror\nf 4 1 5 8\n"
+            "usemtl smooth\nf 2//1 3//2 7//3\nf 2//1 7//3 6//2\n"
+            "usemtl light\nf 9 10 11 12\n"
+            "usemtl glass\nf 13 15 14\nf 13 14 16\nf 14 15 16\nf 15 13 16\n");
+  writeFile(dir + "/features.camera.json",
+            R"({"eye": [0, 1, 3.2], "target": [0, 0.9, 0], "up": [0, 1, 0], "fov_y_deg": 45})");
+  return dir + "/features.obj";
+}
+
+CommandResult runCommand(const std::string& command_) {
+  const std::string command = command_ + " 2>&1";
   CommandResult result;
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return result;

@@ -19,8 +19,15 @@ struct CommandResult {
   int exitCode = -1;
   std::string output;  // stdout and stderr together
 };
+// Runs a shell command line, stdout and stderr together.
+CommandResult runCommand(const std::string& command);
 // Runs the fredholm binary with `args` (a shell-quoted string) and optional environment prefix.
 CommandResult runFredholm(const std::string& args, const std::string& env = "");
+
+// Writes a small scene into `dir` that reaches every material feature the kernels have:
+// a textured floor (map_Kd, UVs), glossy and mirror walls, a glass prism, a wall with
+// shading normals and a light; returns the OBJ's path (camera JSON beside it).
+std::string writeFeatureScene(const std::string& dir);
 
 }  // namespace fh::test
 
