@@ -11,7 +11,8 @@ cd "$(dirname "$0")"
 PACKAGES=(build-essential cmake ninja-build pkg-config
           pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers clinfo
           libopenimageio-dev openimageio-tools libtinyobjloader-dev libgtest-dev
-          libcli11-dev nlohmann-json3-dev)
+          libcli11-dev nlohmann-json3-dev
+          clang oclgrind)  # the portability gates: offline compiles for other targets, a device simulator
 # Optional: Embree for the bench comparison, matplotlib for the charts.
 OPTIONAL_PACKAGES=(libembree-dev python3-matplotlib)
 

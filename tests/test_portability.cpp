@@ -114,3 +114,92 @@ TEST(OfflineCompileWithoutInlining, NoHelperIsLeftUndefined) {
 
 }  // namespace
 }  // namespace fh
+
+namespace fh {
+namespace {
+
+// What a device compiler that does not optimise or inline sees.
+const char* kOptimisationOff = "FREDHOLM_CL_OPTIONS='-cl-opt-disable -DFH_NO_FORCED_INLINE'";
+
+// Writes the feature scene and a scene of twelve coincident copies of a slanted quad under
+// a light (duplicated faces reach the intersect kernel's tie between leaves).
+struct GateScenes {
+  std::string dir = test::tempDir("gate-scenes");
+  std::string features = test::writeFeatureScene(dir);
+  std::string copies = [this] {
+    std::string obj = "mtllib copies.mtl\nv -3 2 -3\nv -3 2 3\nv 3 2 3\nv 3 2 -3\nusemtl light\nf 1 2 3 4\n";
+    obj += "usemtl grey\n";
+    for (int copy = 0; copy < 12; ++copy) {
+      obj += "v -1 -0.7 0.3\nv 1.2 -0.9 -0.4\nv 0.9 1.1 -0.2\nv -1.1 0.8 0.5\n";
+      const int b = 5 + 4 * copy;
+      obj += "f " + std::to_string(b) + " " + std::to_string(b + 1) + " " + std::to_string(b + 2) + " " +
+             std::to_string(b + 3) + "\n";
+    }
+    test::writeFile(dir + "/copies.mtl", "newmtl light\nKd 0 0 0\nKe 4 4 4\nnewmtl grey\nKd 0.5 0.5 0.5\n");
+    test::writeFile(dir + "/copies.obj", obj);
+    test::writeFile(dir + "/copies.camera.json",
+                    R"({"eye": [0, 0, 4], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 50})");
+    return dir + "/copies.obj";
+  }();
+};
+
+double relMse(const std::string& image, const std::string& reference) {
+  const test::CommandResult r = test::runFredholm("compare " + image + " " + reference);
+  const size_t at = r.output.find("\"relmse\"");
+  if (r.exitCode != 0 || at == std::string::npos) return INFINITY;
+  return std::stod(r.output.substr(r.output.find(':', at) + 1));
+}
+
+// With optimisation and forced inlining off, every method renders the feature scene to the
+// same image as the optimised build (up to float rounding, which may steer a few paths).
+TEST(OptimisationOff, EveryMethodRendersWhatTheOptimisedBuildRenders) {
+  const GateScenes scenes;
+  for (const char* method : {"pt", "nee", "mis"}) {
+    const std::string args = "render " + scenes.features + " --method " + method +
+                             " --width 16 --height 16 --spp 16 --seed 5 --wavefront 256 --force -o ";
+    const std::string optimised = scenes.dir + "/" + method + "-optimised.exr";
+    const std::string unoptimised = scenes.dir + "/" + method + "-unoptimised.exr";
+    const std::string cache = "FREDHOLM_CACHE_DIR=" + scenes.dir + "/cache";
+    const test::CommandResult a = test::runFredholm(args + optimised, cache);
+    ASSERT_EQ(a.exitCode, 0) << a.output;
+    const test::CommandResult b = test::runFredholm(args + unoptimised, cache + " " + kOptimisationOff);
+    ASSERT_EQ(b.exitCode, 0) << b.output;
+    EXPECT_NE(a.output.find("glossy, glass, textures, shading normals"), std::string::npos) << a.output;
+    EXPECT_LT(relMse(unoptimised, optimised), 1e-3) << method;
+  }
+}
+
+// Oclgrind simulates an OpenCL device and reports invalid memory accesses, data races and
+// API misuse. Its 21.10 release needs optimisation off (it lacks llvm.bitreverse and the
+// noalias-scope intrinsics that forced inlining leaves) and mis-executes the optimised
+// intersect_block. Every report goes to a log that must stay empty.
+class UnderOclgrind : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(UnderOclgrind, RunsWithoutReports) {
+  ASSERT_TRUE(fs::exists("/usr/bin/oclgrind")) << "oclgrind not found: apt-get install oclgrind";
+  const GateScenes scenes;
+  const std::string run = GetParam();
+  std::string args;
+  if (run == "bench")
+    args = "bench " + scenes.features + " --width 8 --height 8 --repeats 1";
+  else if (run == "aov")
+    args = "render " + scenes.copies + " --aov normal --width 8 --height 8 -o " + scenes.dir + "/aov.exr";
+  else
+    args = "render " + scenes.features + " --method " + run + " --width 8 --height 8 --spp 1 --wavefront 64 -o " +
+           scenes.dir + "/" + run + ".exr";
+  const std::string log = scenes.dir + "/oclgrind.log";
+  const test::CommandResult r = test::runCommand(
+      std::string(kOptimisationOff) + " FREDHOLM_CACHE_DIR=" + scenes.dir + "/cache oclgrind --check-api --data-races" +
+      " --log " + log + " " + FREDHOLM_BINARY + " " + args);
+  EXPECT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("Oclgrind"), std::string::npos) << "not run on Oclgrind's device:\n" << r.output;
+  std::ifstream in(log);
+  const std::string reports((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_TRUE(reports.empty()) << run << ": Oclgrind reported:\n" << reports.substr(0, 4000);
+}
+
+INSTANTIATE_TEST_SUITE_P(Runs, UnderOclgrind, ::testing::Values("pt", "nee", "mis", "aov", "bench"),
+                         [](const ::testing::TestParamInfo<const char*>& p) { return std::string(p.param); });
+
+}  // namespace
+}  // namespace fh
