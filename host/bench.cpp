@@ -96,6 +96,8 @@ Scene bunnyCrowd(const std::string& dir) {
   return scene;
 }
 
+}  // namespace
+
 Scene benchScene(const std::string& spec, std::string& name) {
   const std::string dir = sharedScenesDir();
   auto shared = [&](const std::string& rel) {
@@ -114,6 +116,8 @@ Scene benchScene(const std::string& spec, std::string& name) {
   name = fs::path(spec).stem().string();
   return loadScene(spec);
 }
+
+namespace {
 
 Camera benchCamera(const Scene& scene) {
   if (scene.hasCamera) return scene.camera;

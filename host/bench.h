@@ -22,6 +22,10 @@ struct BenchOptions {
 
 int runBench(const BenchOptions& options);
 
+// A bench scene by name (cornell, bunny-box, sponza, bunnies-1m: the generated scene of
+// about 1.1M triangles) or an OBJ path; `name` is what the bench reports it as.
+Scene benchScene(const std::string& spec, std::string& name);
+
 // The directory of the shared test scenes: $FREDHOLM_SCENES, else ../shared/scenes
 // beside the source tree.
 std::string sharedScenesDir();

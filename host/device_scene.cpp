@@ -1,7 +1,9 @@
 // Uploading a scene: materials, light tables, BVH.
 #include "device_scene.h"
 
+#ifdef FREDHOLM_HAVE_OIIO
 #include <OpenImageIO/imageio.h>
+#endif
 
 #include <cmath>
 #include <cstring>
@@ -102,6 +104,9 @@ SceneFeatures sceneFeatures(const Scene& scene) {
 }
 
 TextureData loadTexture(const std::string& path) {
+#ifndef FREDHOLM_HAVE_OIIO
+  throw Error(path + ": cannot read texture (this build has no OpenImageIO)");
+#else
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw Error(path + ": cannot read texture (" + OIIO::geterror() + ")");
   const OIIO::ImageSpec& spec = in->spec();
@@ -123,6 +128,7 @@ TextureData loadTexture(const std::string& path) {
     t.texels[4 * p + 3] = 1.f;
   }
   return t;
+#endif
 }
 
 DeviceScene::DeviceScene(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const SceneFeatures& f)

@@ -1,7 +1,10 @@
-// OpenImageIO output and the checks made before any rendering starts.
+// OpenImageIO output and the checks made before any rendering starts. A build without
+// OpenImageIO (the self-contained GPU bundle, bench/gpu/) reads and writes PFM only.
 #include "image_io.h"
 
+#ifdef FREDHOLM_HAVE_OIIO
 #include <OpenImageIO/imageio.h>
+#endif
 #include <unistd.h>
 
 #include <algorithm>
@@ -36,6 +39,23 @@ void writePfm(const std::string& path, const Image& image) {
   if (!out) throw Error("cannot write '" + path + "': write failed");
 }
 
+Image readPfm(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string magic;
+  Image image;
+  double scale = 0.0;
+  if (!(in >> magic >> image.width >> image.height >> scale) || magic != "PF" || image.width <= 0 ||
+      image.height <= 0 || scale >= 0.0 || image.width > (1 << 16) || image.height > (1 << 16))
+    throw Error("cannot read '" + path + "': not a little-endian RGB PFM file");
+  in.get();  // the single whitespace byte before the pixels
+  image.rgb.resize(size_t(image.width) * size_t(image.height) * 3);
+  for (int y = image.height - 1; y >= 0; --y)
+    in.read(reinterpret_cast<char*>(&image.rgb[size_t(y) * size_t(image.width) * 3]),
+            std::streamsize(size_t(image.width) * 3 * sizeof(float)));
+  if (!in) throw Error("cannot read '" + path + "': file ends early");
+  return image;
+}
+
 }  // namespace
 
 float linearToSrgb(float x) {
@@ -48,6 +68,10 @@ float srgbToLinear(float x) { return x <= 0.04045f ? x / 12.92f : std::pow((x + 
 ImageEncoding checkOutputPath(const std::string& path, bool force, const std::string& flag) {
   const std::string ext = extensionOf(path);
   ImageEncoding encoding;
+#ifndef FREDHOLM_HAVE_OIIO
+  if (ext != ".pfm")
+    throw Error(flag + " '" + path + "': this build has no OpenImageIO and writes .pfm only");
+#endif
   if (ext == ".exr" || ext == ".hdr" || ext == ".pfm") encoding = ImageEncoding::LinearFloat;
   else if (ext == ".png" || ext == ".jpg" || ext == ".jpeg") encoding = ImageEncoding::Srgb8;
   else
@@ -82,6 +106,7 @@ std::string firstFreeName(const std::string& path) {
 void writeImage(const std::string& path, const Image& image, const std::map<std::string, std::string>& metadata) {
   const ImageEncoding encoding = checkOutputPath(path, true);
   if (extensionOf(path) == ".pfm") return writePfm(path, image);
+#ifdef FREDHOLM_HAVE_OIIO
   auto out = OIIO::ImageOutput::create(path);
   if (!out) throw Error("cannot write '" + path + "': " + OIIO::geterror());
   const bool isFloat = encoding == ImageEncoding::LinearFloat;
@@ -100,9 +125,16 @@ void writeImage(const std::string& path, const Image& image, const std::map<std:
     ok = out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
   }
   if (!ok || !out->close()) throw Error("cannot write '" + path + "': " + out->geterror());
+#else
+  (void)encoding;
+  (void)metadata;
+#endif
 }
 
 Image readImage(const std::string& path) {
+#ifndef FREDHOLM_HAVE_OIIO
+  return readPfm(path);
+#else
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw Error("cannot read '" + path + "': " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
@@ -120,6 +152,7 @@ Image readImage(const std::string& path) {
       image.rgb[3 * p + size_t(c)] = srgb ? srgbToLinear(v) : v;
     }
   return image;
+#endif
 }
 
 }  // namespace fh

@@ -81,9 +81,13 @@ Camera chooseCamera(const RenderOptions& o, const Scene& scene) {
   return camera;
 }
 
-// An OBJ path, builtin:NAME, or nothing for the built-in Cornell box.
+// An OBJ path, builtin:NAME, bench:NAME (a bench scene), or nothing for the Cornell box.
 Scene loadSceneSpec(const std::string& spec) {
   if (spec.empty()) return loadDefaultScene();
+  if (spec.rfind("bench:", 0) == 0) {
+    std::string name;
+    return benchScene(spec.substr(6), name);
+  }
   return isBuiltinSpec(spec) ? builtinScene(spec) : loadScene(spec);
 }
 

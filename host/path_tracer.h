@@ -75,12 +75,12 @@ struct RenderStats {
 // samples_per_second, nonfinite_samples and devices ({name, samples}).
 std::string statsJson(const RenderStats& stats, const RenderSettings& settings);
 
-// The default number of paths in flight: about 1M on a GPU, fewer on a CPU, where the
-// path state should stay near the caches; never more than two passes of pixels.
 // The path tracer's program for a scene's features, a method and the passes in flight.
 ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsigned passSlots,
                               const std::string& traversalOptions);
 
+// The default number of paths in flight: 512k on a GPU, fewer on a CPU, where the
+// path state should stay near the caches; never more than two passes of pixels.
 size_t defaultWavefront(const DeviceInfo& device, size_t pixels);
 
 // Where a device's passes come from when several devices share a render: take() hands

@@ -203,3 +203,33 @@ INSTANTIATE_TEST_SUITE_P(Runs, UnderOclgrind, ::testing::Values("pt", "nee", "mi
 
 }  // namespace
 }  // namespace fh
+
+namespace fh {
+namespace {
+
+// The GPU measurement script runs end to end here too, on PoCL with small sizes, so a first
+// GPU attempt can fail only on what is truly GPU-specific. Its CPU comparison then compares
+// two renders of the same CPU device: their relMSE must match that of two seeds.
+TEST(GpuScript, RunsEndToEndOnPoclWithSmallSizes) {
+  const std::string out = test::tempDir("gpu-script");
+  const test::CommandResult r = test::runCommand(std::string(FREDHOLM_SOURCE_DIR) + "/bench/gpu/run_gpu.sh --small " +
+                                                 FREDHOLM_BINARY + " " + out);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  std::ifstream in(out + "/results.json");
+  std::stringstream json;
+  json << in.rdbuf();
+  const std::string results = json.str();
+  auto number = [&](const std::string& key) {
+    const size_t at = results.find("\"" + key + "\"");
+    return at == std::string::npos ? NAN : std::stod(results.substr(results.find(':', at) + 1));
+  };
+  EXPECT_GT(number("msamples_per_s"), 0.0) << results;
+  EXPECT_GT(number("best_wavefront"), 0.0) << results;
+  const double ratio = number("relmse_ratio_to_two_gpu_seeds");
+  EXPECT_GT(ratio, 0.5) << results;
+  EXPECT_LT(ratio, 2.0) << results;
+  EXPECT_NE(results.find("\"missing\": []"), std::string::npos) << results;
+}
+
+}  // namespace
+}  // namespace fh

@@ -1,0 +1,132 @@
+#!/usr/bin/env bash
+# Measures fredholm on whatever OpenCL devices a machine has (written for a GPU machine
+# that has NVIDIA's driver but nothing of fredholm's), and writes what it found as JSON.
+#
+#   bench/gpu/run_gpu.sh [--small] FREDHOLM OUTDIR
+#
+# FREDHOLM is a bundle from bench/gpu/make_bundle.sh (run through the bundle's own
+# dynamic loader, so the machine's glibc does not matter) or a fredholm binary. --small
+# shrinks every size so the whole script runs in a minute on PoCL (the test suite does).
+# Steps: probe the machine; find NVIDIA's OpenCL library when no ICD file names it;
+# `fredholm devices`; the Cornell box at 512x512, mis, 1024 spp on the GPU (twice, two
+# seeds: the noise level) and on a CPU device or against the bundle's CPU render, compared;
+# `fredholm bench` on the four default scenes; a wavefront-size sweep; a render of the
+# 1.1M-triangle scene. OUTDIR/results.json holds it all; OUTDIR/log.txt every command.
+set -uo pipefail
+
+small=0
+if [ "${1:-}" = "--small" ]; then small=1; shift; fi
+if [ $# -ne 2 ]; then
+  echo "usage: $0 [--small] FREDHOLM_BUNDLE_OR_BINARY OUTDIR" >&2
+  exit 2
+fi
+target=$1
+out=$2
+mkdir -p "$out" || exit 2
+log="$out/log.txt"
+: >"$log"
+here=$(cd "$(dirname "$0")" && pwd)
+
+if [ $small -eq 1 ]; then
+  size=32; spp=16; sweep_spp=4; sweep="1024 2048 4096"; bench_size=32; repeats=1; big_size=32; big_spp=2
+else
+  size=512; spp=1024; sweep_spp=64; sweep="262144 524288 1048576 2097152 4194304"; bench_size=512; repeats=5
+  big_size=512; big_spp=64
+fi
+
+# ---- The machine ------------------------------------------------------------------------
+{
+  echo "== uname"; uname -a
+  echo "== os"; head -4 /etc/os-release 2>/dev/null
+  echo "== glibc"; ldd --version 2>/dev/null | head -1
+  echo "== cpus"; nproc
+  echo "== nvidia-smi"; nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv 2>&1 || true
+  echo "== OpenCL ICD files"; ls -l /etc/OpenCL/vendors 2>&1 || true
+} >"$out/probe.txt" 2>&1
+
+# NVIDIA's OpenCL driver, for an ICD loader that has no vendors file naming it.
+find_nvidia_opencl() {
+  local d
+  for d in /usr/local/nvidia/lib64 /usr/local/nvidia/lib /usr/lib/x86_64-linux-gnu /usr/lib64 /usr/lib \
+           /usr/local/cuda/lib64 /usr/local/cuda/compat /usr/local/cuda/targets/x86_64-linux/lib; do
+    [ -e "$d/libnvidia-opencl.so.1" ] && { echo "$d/libnvidia-opencl.so.1"; return; }
+  done
+  ldconfig -p 2>/dev/null | awk '/libnvidia-opencl.so.1/ {print $NF; exit}'
+}
+nvidia_opencl=$(find_nvidia_opencl)
+vendors="$out/icd-vendors"
+rm -rf "$vendors"
+mkdir -p "$vendors"
+cp /etc/OpenCL/vendors/*.icd "$vendors/" 2>/dev/null
+if [ -n "$nvidia_opencl" ] && ! grep -qs nvidia "$vendors"/*.icd; then
+  echo "$nvidia_opencl" >"$vendors/nvidia-found.icd"
+fi
+export OCL_ICD_VENDORS="$vendors"
+echo "nvidia_opencl=${nvidia_opencl:-none}" >>"$out/probe.txt"
+
+# ---- How to run fredholm ----------------------------------------------------------------
+if [ -d "$target" ]; then
+  libpath="$target/lib"
+  [ -n "$nvidia_opencl" ] && libpath="$libpath:$(dirname "$nvidia_opencl")"
+  fredholm=("$target/lib/ld-linux-x86-64.so.2" --library-path "$libpath" "$target/bin/fredholm")
+  [ -d "$target/scenes" ] && export FREDHOLM_SCENES="$target/scenes"
+  cpu_reference="$target/reference/cornell-mis.pfm"
+else
+  fredholm=("$target")
+  cpu_reference=""
+fi
+export FREDHOLM_CACHE_DIR="$out/program-cache"
+
+# Runs fredholm with a time limit, logging the command and its output; returns its status.
+fh() {
+  local limit=$1
+  shift
+  echo "\$ fredholm $*" >>"$log"
+  timeout "$limit" "${fredholm[@]}" "$@" >>"$log" 2>&1
+  local rc=$?
+  echo "(exit $rc)" >>"$log"
+  return $rc
+}
+
+if ! fh 60 devices; then
+  # Say why no platform was found: the ICD loader's own account.
+  OCL_ICD_DEBUG=15 timeout 60 "${fredholm[@]}" devices >>"$log" 2>&1
+fi
+"${fredholm[@]}" devices >"$out/devices.txt" 2>&1
+if fh 60 devices --device gpu; then gpu=gpu; else gpu=0; fi
+if fh 60 devices --device cpu; then cpu=cpu; else cpu=""; fi
+echo "gpu_device=$gpu cpu_device=${cpu:-none}" >>"$out/probe.txt"
+
+# ---- The Cornell box on the GPU and on a CPU --------------------------------------------
+cornell=(render --method mis --width $size --height $size --spp $spp --force)
+fh 900 "${cornell[@]}" --device "$gpu" --seed 1 -o "$out/gpu.pfm" --stats "$out/gpu-stats.json"
+fh 900 "${cornell[@]}" --device "$gpu" --seed 2 -o "$out/gpu-seed2.pfm"
+fh 60 compare "$out/gpu.pfm" "$out/gpu-seed2.pfm" && "${fredholm[@]}" compare "$out/gpu.pfm" "$out/gpu-seed2.pfm" \
+  >"$out/compare-gpu-seeds.json" 2>>"$log"
+if [ -n "$cpu" ]; then
+  fh 1800 "${cornell[@]}" --device "$cpu" --seed 3 -o "$out/cpu.pfm" --stats "$out/cpu-stats.json"
+elif [ -n "$cpu_reference" ] && [ -f "$cpu_reference" ] && [ $small -eq 0 ]; then
+  cp "$cpu_reference" "$out/cpu.pfm"
+  cp "${cpu_reference%.pfm}.json" "$out/cpu-stats.json" 2>/dev/null
+fi
+if [ -f "$out/cpu.pfm" ]; then
+  "${fredholm[@]}" compare "$out/gpu.pfm" "$out/cpu.pfm" >"$out/compare-gpu-cpu.json" 2>>"$log"
+fi
+
+# ---- Ray casting, the wavefront sweep, the 1.1M-triangle scene -------------------------
+bench_scenes=(cornell)
+if [ -n "${FREDHOLM_SCENES:-}" ] || [ -d "$here/../../../shared/scenes" ]; then
+  bench_scenes=(cornell bunny-box sponza bunnies-1m)
+fi
+fh 900 bench "${bench_scenes[@]}" --device "$gpu" --width $bench_size --height $bench_size --repeats $repeats \
+  --json "$out/bench.json" --force
+for wavefront in $sweep; do
+  fh 600 render --method mis --width $size --height $size --spp $sweep_spp --device "$gpu" --wavefront "$wavefront" \
+    -o "$out/sweep.pfm" --stats "$out/sweep-$wavefront.json" --force
+done
+if [ ${#bench_scenes[@]} -gt 1 ]; then
+  fh 900 render bench:bunnies-1m --method mis --width $big_size --height $big_size --spp $big_spp --device "$gpu" \
+    -o "$out/bunnies-1m.pfm" --stats "$out/bunnies-1m.json" --force
+fi
+
+python3 "$here/collect_results.py" "$out" $small
