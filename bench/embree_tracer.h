@@ -1,6 +1,6 @@
 // Embree 3 as the reference CPU tracer for `fredholm bench`.
 #pragma once
-#include "external_tracer.h"
+#include "bench/external_tracer.h"
 
 namespace fh {
 std::unique_ptr<ExternalTracer> makeEmbreeTracer();

@@ -38,7 +38,7 @@ def main():
     ax.set_xscale("log")
     ax.set_xlabel("triangles")
     ax.set_ylabel("Mrays/s")
-    ax.set_title(f"Ray casting throughput on {doc['device']}\n"
+    ax.set_title(f"Ray casting throughput on {', '.join(doc['devices']) if 'devices' in doc else doc['device']}\n"
                  f"({doc['primary_rays']} primary rays per batch, median of {doc['repeats']})", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)

@@ -70,7 +70,7 @@ FH_INLINE Bsdf material_bsdf(__global const GpuMaterial* m) {
 
 FH_INLINE bool bsdf_has_smooth_lobe(const Bsdf* b) { return (b->lobes & (FH_LOBE_DIFFUSE | FH_LOBE_GLOSSY)) != 0; }
 
-// Scenes are compiled with only the lobes they use (host/device_scene.cpp): FH_GLOSSY
+// Scenes are compiled with only the lobes they use (host/render/device_scene.cpp): FH_GLOSSY
 // for glossy and mirror surfaces, FH_GLASS for dielectrics. Without them the branches
 // below are dead code the compiler removes.
 #if !defined(FH_GLOSSY)

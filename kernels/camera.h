@@ -1,5 +1,5 @@
 // The pinhole camera: a ray through image position (px, py) in pixels, (0,0) at the
-// top-left corner; right = forward x up (see host/camera.h).
+// top-left corner; right = forward x up (see host/scene/camera.h).
 #ifndef FH_CAMERA_H
 #define FH_CAMERA_H
 

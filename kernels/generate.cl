@@ -1,43 +1,23 @@
-// The generate stage: camera rays. generate_paths starts new samples in free path slots
-// and queues them for intersection (the wavefront's refill); generate_camera_rays makes
-// one batch of camera rays for the debug views and the bench.
+// The generate stage: camera rays. generate starts the samples plan_iteration planned in
+// free path slots and queues them for intersection (the wavefront's refill);
+// generate_camera_rays makes one batch of camera rays for the debug views and the bench.
 #include "camera.h"
 #include "film.h"
 #include "path_state.h"
 #include "sampler.h"
-
-// Plans one iteration (a single work-item): how many new samples start (as many as free
-// slots, up to the limit the host set), where they take their slots and queue places,
-// and resets this iteration's queues.
-__kernel void plan_iteration(volatile __global uint* counters, uint ray_counter, uint next_counter) {
-  if (get_global_id(0) != 0) return;
-  const uint free_slots = counters[FH_COUNT_FREE], next = counters[FH_COUNT_NEXT_SAMPLE];
-  const uint limit = counters[FH_COUNT_SAMPLE_LIMIT];
-  const uint count = min(free_slots, limit - min(limit, next));
-  counters[FH_COUNT_GEN_COUNT] = count;
-  counters[FH_COUNT_GEN_FIRST] = next;
-  counters[FH_COUNT_GEN_FREE_TOP] = free_slots;
-  counters[FH_COUNT_GEN_QUEUE_BASE] = counters[ray_counter];
-  counters[FH_COUNT_FREE] = free_slots - count;
-  counters[FH_COUNT_NEXT_SAMPLE] = next + count;
-  counters[ray_counter] += count;
-  counters[next_counter] = 0;
-  counters[FH_COUNT_SHADOW] = 0;
-  counters[FH_COUNT_FINISHED] = 0;
-}
 
 // Starts the planned samples in the slots on top of the free list and appends them to
 // the ray queue. A device numbers its samples locally (j); its passes are granted by the
 // host, which may hand different passes to different devices: local pass j / pixel_count
 // is global pass pass_table[j / pixel_count]. Global sample k = pass * pixel_count + pixel
 // seeds the random numbers, so a sample is the same whichever device renders it.
-__kernel void generate_paths(RenderParams params, __global const uint* counters, __global const uint* free_list,
-                             __global uint* ray_queue, __global const float* filter_table,
-                             __global const uint* pass_table FH_PATH_PARAMS) {
+__kernel void generate(RenderParams params, __global const WavefrontCounters* counters,
+                       __global const uint* free_list, __global uint* ray_queue, __global const float* filter_table,
+                       __global const uint* pass_table FH_PATH_PARAMS) {
   const uint i = get_global_id(0);
-  if (i >= counters[FH_COUNT_GEN_COUNT]) return;
-  const uint slot = free_list[counters[FH_COUNT_GEN_FREE_TOP] - 1 - i];
-  const uint j = counters[FH_COUNT_GEN_FIRST] + i;
+  if (i >= counters->new_count) return;
+  const uint slot = free_list[counters->new_free_top - 1 - i];
+  const uint j = counters->new_first + i;
   const uint pixel = j % params.pixel_count, device_pass = j / params.pixel_count;
   const uint pass = pass_table[device_pass];
   const uint k = pass * params.pixel_count + pixel;
@@ -50,11 +30,12 @@ __kernel void generate_paths(RenderParams params, __global const uint* counters,
   ray_org[slot] = (float4)(vload3(0, params.camera.origin), 0.0f);
   ray_dir[slot] = (float4)(camera_ray_direction(&params.camera, px, py), INFINITY);
   throughput[slot] = (float4)(1.0f, 1.0f, 1.0f, 0.0f);
+  ray_pdf[slot] = 0.0f;
   radiance[slot] = (float4)(0.0f);
   sample_id[slot] = k;
   local_pass[slot] = device_pass;
   depth[slot] = 0;
-  ray_queue[counters[FH_COUNT_GEN_QUEUE_BASE] + i] = slot;
+  ray_queue[counters->new_queue_base + i] = slot;
 }
 
 __kernel void generate_camera_rays(CameraParams cam, uint seed, uint sample_index, uint first_pixel,

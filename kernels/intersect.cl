@@ -1,5 +1,5 @@
-// The intersect stage: closest hit for path rays, any hit for shadow rays, over a queue
-// of rays stored as float4 pairs (origin.xyz + tmin, direction.xyz + tmax).
+// Ray casting: closest hit and any hit over arrays of rays stored as float4 pairs
+// (origin.xyz + tmin, direction.xyz + tmax), and the path tracer's intersect stage.
 #include "intersect.h"
 
 // hits[i] = (t, b1, b2, triangle index in BVH order as bits; -1 on a miss). Per-triangle
@@ -24,13 +24,13 @@ __kernel void intersect_any(__global const Bvh8Node* nodes, __global const Trian
   occluded[i] = trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w, true).triangle >= 0;
 }
 
-// Closest hit for the paths in a ray queue (its length is counters[ray_counter]): reads
-// ray_org/ray_dir, writes hit.
-__kernel void intersect_paths(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
-                              __global const uint* ray_queue, __global const uint* counters, uint ray_counter,
-                              __global const float4* ray_org, __global const float4* ray_dir, __global float4* hit) {
+// The intersect stage: closest hit for the paths in the current ray queue (parity picks
+// its length); reads ray_org/ray_dir, writes hit.
+__kernel void intersect(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
+                        __global const uint* ray_queue, __global const WavefrontCounters* counters, uint parity,
+                        __global const float4* ray_org, __global const float4* ray_dir, __global float4* hit) {
   const uint i = get_global_id(0);
-  if (i >= counters[ray_counter]) return;
+  if (i >= counters->ray_length[parity]) return;
   const uint p = ray_queue[i];
   const float4 o = ray_org[p], d = ray_dir[p];
   const TraceHit h = trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w, false);

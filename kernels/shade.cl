@@ -7,6 +7,7 @@
 #include "bsdf.h"
 #include "lights.h"
 #include "path_state.h"
+#include "queues.h"
 #include "ray.h"
 #include "sampler.h"
 #include "surface.h"
@@ -34,31 +35,33 @@ FH_INLINE float emission_weight(uint depth, float bsdf_pdf, __global const float
 }
 
 __kernel void shade(RenderParams params, __global const uint* ray_queue, __global uint* next_queue,
-                    __global uint* finished_queue, volatile __global uint* counters, uint ray_counter,
-                    uint next_counter,
+                    __global uint* finished_queue, volatile __global WavefrontCounters* counters, uint parity,
                     __global const float4* triangles, __global const int* triangle_material,
                     __global const GpuMaterial* materials, __global const float* light_pdf_area,
                     __global const float4* normals, __global const float2* uvs, __global const float4* texels,
                     __global const uint4* texture_info FH_PATH_PARAMS FH_SHADOW_PARAMS) {
   volatile __local uint scratch[2];
-  const uint i = get_global_id(0), count = counters[ray_counter];
+  const uint i = get_global_id(0), count = counters->ray_length[parity];
   bool continues = false, light_sample = false, finishes = false;
   uint p = 0;
   // What a light-sample request needs, kept until its queue position is known.
-  float4 request_position = (float4)(0.0f), request_normal = (float4)(0.0f), request_beta = (float4)(0.0f);
-  float3 request_wo = (float3)(0.0f), request_geometric = (float3)(0.0f), request_albedo = (float3)(0.0f);
+  float4 request_position = (float4)(0.0f);
+  float3 request_normal = (float3)(0.0f), request_beta = (float3)(0.0f), request_wo = (float3)(0.0f),
+         request_geometric = (float3)(0.0f), request_albedo = (float3)(0.0f);
+  int request_material = 0;
+  uint request_depth = 0;
 
   if (i < count) {
     p = ray_queue[i];
     const float4 h = hit[p];
     const float3 dir = ray_dir[p].xyz;
-    float4 beta = throughput[p];
+    float3 beta = throughput[p].xyz;
     float3 gathered = radiance[p].xyz;
     const uint bounce = depth[p];
     const int t = as_int(h.w);
 
     if (t < 0) {
-      gathered += beta.xyz * vload3(0, params.env);
+      gathered += beta * vload3(0, params.env);
     } else {
       const SurfacePoint s = surface_point(triangles, t, h.y, h.z);
       const int material_id = triangle_material[t];
@@ -71,8 +74,8 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
       // connects from, so the two strategies weigh the same paths.
       const float3 ke = vload3(0, m->ke);
       if (cos_front > 0.0f && (ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f))
-        gathered += beta.xyz * ke * emission_weight(bounce, beta.w, triangles, t, light_pdf_area[t], ray_org[p].xyz,
-                                                    h.x * h.x, cos_front);
+        gathered += beta * ke * emission_weight(bounce, ray_pdf[p], triangles, t, light_pdf_area[t], ray_org[p].xyz,
+                                                h.x * h.x, cos_front);
 
 #if defined(FH_SHADING_NORMALS)
       const float3 ns = shading_normal(normals, t, h.y, h.z, s.normal);
@@ -91,11 +94,13 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
       const float3 n = cos_front >= 0.0f ? ns : -ns;
       light_sample = may_bounce && params.light_count > 0 && bsdf_has_smooth_lobe(&bsdf);
       request_position = (float4)(s.position, s.magnitude);
-      request_normal = (float4)(n, as_float(material_id));
+      request_normal = n;
       request_geometric = g;
       request_albedo = bsdf.kd;
-      request_beta = (float4)(beta.xyz, as_float(bounce));
+      request_beta = beta;
       request_wo = wo;
+      request_material = material_id;
+      request_depth = bounce;
 #endif
 
       if (may_bounce) {
@@ -106,20 +111,21 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
         float pdf;
         const float3 weight =
             bsdf_sample(&bsdf, s.normal, ns, wo, sample_1d(&sampler, dim + FH_DIM_BSDF_LOBE), u.x, u.y, &wi, &pdf);
-        beta = (float4)(beta.xyz * weight, pdf);
+        beta *= weight;
         continues = pdf != 0.0f;
         // Russian roulette: survive with a probability from the throughput (capped, so
         // bright paths still end); dividing by it keeps the estimator unbiased.
         if (continues && bounce + 1 >= params.rr_depth) {
           const float survive = fmin(fmax(fmax(beta.x, beta.y), beta.z), 0.95f);
           if (sample_1d(&sampler, dim + FH_DIM_ROULETTE) >= survive) continues = false;
-          else beta.xyz /= survive;
+          else beta /= survive;
         }
         continues = continues && (beta.x > 0.0f || beta.y > 0.0f || beta.z > 0.0f);
         if (continues) {
           ray_org[p] = (float4)(offset_ray_origin(&s, wi), 0.0f);
           ray_dir[p] = (float4)(wi, INFINITY);
-          throughput[p] = beta;
+          throughput[p] = (float4)(beta, 0.0f);
+          ray_pdf[p] = pdf;
           depth[p] = bounce + 1;
         }
       }
@@ -128,18 +134,17 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
     finishes = !continues;
   }
 
-  const uint next = group_append(continues, &counters[next_counter], scratch);
-  if (continues) next_queue[next] = p;
-  const uint request = group_append(light_sample, &counters[FH_COUNT_SHADOW], scratch);
+  queue_append(continues, p, next_queue, &counters->ray_length[1 - parity], scratch);
+  const uint request = queue_append(light_sample, p, shadow_path, &counters->shadow_length, scratch);
   if (light_sample) {
-    shadow_path[request] = p;
     shadow_position[request] = request_position;
-    shadow_normal[request] = request_normal;
-    shadow_throughput[request] = request_beta;
+    shadow_normal[request] = (float4)(request_normal, 0.0f);
+    shadow_throughput[request] = (float4)(request_beta, 0.0f);
     shadow_wo[request] = (float4)(request_wo, 0.0f);
     shadow_geometric[request] = (float4)(request_geometric, 0.0f);
     shadow_albedo[request] = (float4)(request_albedo, 0.0f);
+    shadow_material[request] = request_material;
+    shadow_depth[request] = request_depth;
   }
-  const uint done = group_append(finishes, &counters[FH_COUNT_FINISHED], scratch);
-  if (finishes) finished_queue[done] = p;
+  queue_append(finishes, p, finished_queue, &counters->finished_length, scratch);
 }

@@ -10,24 +10,24 @@
 #include "sampler.h"
 #include "sampling.h"
 
-__kernel void shadow_connect(RenderParams params, volatile __global uint* counters,
+__kernel void shadow_connect(RenderParams params, __global const WavefrontCounters* counters,
                              __global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
                              __global const float4* triangles, __global const int* triangle_material,
                              __global const GpuMaterial* materials, __global const float* light_cdf,
                              __global const int* light_triangle, __global const float* light_pdf_area
                                  FH_PATH_PARAMS FH_SHADOW_PARAMS) {
   const uint i = get_global_id(0);
-  if (i >= counters[FH_COUNT_SHADOW]) return;
+  if (i >= counters->shadow_length) return;
   const uint p = shadow_path[i];
-  const float4 position = shadow_position[i], normal = shadow_normal[i];
+  const float4 position = shadow_position[i];
   SurfacePoint s;
   s.position = position.xyz;
   s.magnitude = position.w;
   s.normal = shadow_geometric[i].xyz;  // the geometric normal on the viewer's side
-  const float3 n = normal.xyz;          // the shading normal, same side
-  const float4 beta = shadow_throughput[i];  // w: the bounce count at the shading point
+  const float3 n = shadow_normal[i].xyz;  // the shading normal, same side
+  const float3 beta = shadow_throughput[i].xyz;
   const PixelSampler sampler = pixel_sampler(params.seed, sample_id[p], params.pixel_count);
-  const uint dim = (uint)as_int(beta.w) * FH_DIMS_PER_BOUNCE;
+  const uint dim = shadow_depth[i] * FH_DIMS_PER_BOUNCE;
 
   // Connect from the point just off the surface that BSDF-sampled rays also start from:
   // both strategies then see the same geometry, and their MIS weights sum to one even
@@ -50,7 +50,7 @@ __kernel void shadow_connect(RenderParams params, volatile __global uint* counte
   // Behind the surface (by either normal: no light leaks through), or the light's back.
   if (cos_surface <= 0.0f || dot(s.normal, wi) <= 0.0f || cos_light <= 0.0f) return;
 
-  Bsdf bsdf = material_bsdf(materials + as_int(normal.w));
+  Bsdf bsdf = material_bsdf(materials + shadow_material[i]);
   bsdf.kd = shadow_albedo[i].xyz;  // textured or not, as shade found it
   const float3 wo = shadow_wo[i].xyz;
   const float3 f = bsdf_eval(&bsdf, n, wo, wi);
@@ -61,7 +61,7 @@ __kernel void shadow_connect(RenderParams params, volatile __global uint* counte
   const float weight = 1.0f;
 #endif
   const float3 ke = vload3(0, materials[triangle_material[lt]].ke);
-  const float3 contribution = beta.xyz * f * ke * (cos_surface * weight / pdf_light);
+  const float3 contribution = beta * f * ke * (cos_surface * weight / pdf_light);
   if (!(contribution.x > 0.0f || contribution.y > 0.0f || contribution.z > 0.0f)) return;
 
   // V(x, y): the segment from just off the surface to just short of the light point.

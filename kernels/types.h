@@ -47,7 +47,7 @@ typedef struct {
   int id[8];
 } TriangleBlock8;
 
-// Camera for the generate kernel; see host/camera.h for the conventions.
+// Camera for the generate kernel; see host/scene/camera.h for the conventions.
 typedef struct {
   float origin[4];
   float forward[4];
@@ -57,7 +57,7 @@ typedef struct {
   int pad0, pad1;
 } CameraParams;
 
-// A material as the kernels see it (host/device_scene.cpp maps MTL onto it). Only the
+// A material as the kernels see it (host/render/device_scene.cpp maps MTL onto it). Only the
 // fields a stage uses are read: diffuse and emission today, the rest for later lobes.
 typedef struct {
   float kd[4];  // diffuse albedo rgb
@@ -80,6 +80,30 @@ typedef struct {
   float filter_radius;
   uint pad0;
 } RenderParams;
+
+// The wavefront's queue lengths and books, one struct in one device buffer. The device
+// keeps its own books (iteration.cl), so the host can queue many iterations without
+// waiting for any: it reads this back only now and then. 64-bit totals are (low, high)
+// pairs, as OpenCL 1.2 has no 64-bit atomics to rely on.
+#define FH_MAX_PASS_SLOTS 8  // passes in flight at most (the host picks FH_PASS_SLOTS <= this)
+typedef struct {
+  uint ray_length[2];    // the two ray queues; the iteration's parity says which is current
+  uint shadow_length;    // light-sample requests this iteration
+  uint finished_length;  // paths finished this iteration
+  uint free_length;      // free path slots: the free list's length
+  uint nonfinite;        // samples whose radiance was NaN or infinite (dropped)
+  uint next_sample;      // samples started so far on this device (local numbering)
+  uint sample_limit;     // local samples that may start: the passes granted so far
+  uint new_count;        // this iteration's new samples,
+  uint new_first;        // ... the first one's local index,
+  uint new_free_top;     // ... the free list's length before they took their slots,
+  uint new_queue_base;   // ... and where they go in the ray queue
+  uint bounce_rays[2];   // rays traced after a bounce
+  uint shadow_rays[2];   // light-sample requests (shadow rays at most)
+  uint queued_rays[2];   // rays in the current queue, summed over iterations (occupancy)
+  uint iterations;
+  uint pass_done[FH_MAX_PASS_SLOTS];  // per pass slot: paths finished in the pass it holds
+} WavefrontCounters;
 
 // Ray buffers hold float4 pairs: origin.xyz + tmin, direction.xyz + tmax.
 // Hit buffers hold float4: t, barycentric b1, b2, and the triangle index in BVH order as

@@ -1,8 +1,8 @@
 // Scenes built in code for closed-form tests: quads and boxes with chosen materials.
 #pragma once
-#include "scene.h"
-#include "scene_loader.h"
-#include "vec.h"
+#include "base/vec.h"
+#include "scene/scene.h"
+#include "scene/scene_loader.h"
 
 namespace fh::test {
 

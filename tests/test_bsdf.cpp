@@ -10,11 +10,11 @@
 
 #include <array>
 
-#include "device_scene.h"
-#include "image_io.h"
-#include "kernel_sources.h"
-#include "path_tracer.h"
-#include "program.h"
+#include "device/kernel_sources.h"
+#include "device/program.h"
+#include "image/image_io.h"
+#include "render/device_scene.h"
+#include "render/render.h"
 #include "scene_builder.h"
 #include "test_support.h"
 
@@ -265,9 +265,9 @@ TEST(WhiteFurnace, LosslessObjectsVanishInAUniformEnclosure) {
       s.width = s.height = 16;
       s.spp = 64;
       s.method = method;
-      PathTracer tracer(dc, scene, bvh, camera, s);
-      const Film film = tracer.render();
-      EXPECT_EQ(tracer.stats().nonfinite, 0u);
+      const RenderResult r = render(dc, scene, bvh, camera, s);
+      const Film& film = r.film;
+      EXPECT_EQ(r.stats.nonfinite, 0u);
       double mean = 0, var = 0;
       for (size_t p = 0; p < 256; ++p) {
         mean += film.sum[4 * p] / film.count(p) / 256;
@@ -322,8 +322,7 @@ TEST(Textures, AlbedoComesFromTheImageDecodedToLinear) {
   s.spp = 16;
   s.method = Method::PT;
   s.env = {1.f, 1.f, 1.f};
-  PathTracer tracer(dc, scene, bvh, camera, s);
-  const Image img = tracer.render().image();
+  const Image img = render(dc, scene, bvh, camera, s).film.image();
   // The camera sees only the plane; rows 0-2 lie in the texture's top half, 5-7 in the bottom.
   for (int y : {0, 1, 2, 5, 6, 7})
     for (int x = 0; x < 8; ++x)

@@ -4,10 +4,11 @@
 
 #include <cmath>
 
-#include "camera.h"
-#include "error.h"
+#include "base/error.h"
+#include "base/vec.h"
+#include "cli/flags.h"
+#include "scene/camera.h"
 #include "test_support.h"
-#include "vec.h"
 
 namespace fh {
 namespace {

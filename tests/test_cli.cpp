@@ -7,7 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "image_io.h"
+#include "image/image_io.h"
 #include "test_support.h"
 
 namespace fh {

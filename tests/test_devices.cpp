@@ -1,7 +1,7 @@
 // Device listing and the --device grammar, on PoCL; the CLI's messages and exit codes.
 #include <gtest/gtest.h>
 
-#include "devices.h"
+#include "device/devices.h"
 #include "test_support.h"
 
 namespace fh {

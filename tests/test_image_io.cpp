@@ -6,9 +6,9 @@
 
 #include <filesystem>
 
-#include "error.h"
-#include "error_metrics.h"
-#include "image_io.h"
+#include "base/error.h"
+#include "image/error_metrics.h"
+#include "image/image_io.h"
 #include "test_support.h"
 
 namespace fh {

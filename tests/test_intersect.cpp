@@ -15,11 +15,11 @@
 #include <future>
 #include <random>
 
-#include "bvh.h"
-#include "ray_workload.h"
-#include "scene_loader.h"
+#include "accel/bvh.h"
+#include "base/vec.h"
+#include "bench/ray_workload.h"
+#include "scene/scene_loader.h"
 #include "test_support.h"
-#include "vec.h"
 
 namespace fh {
 namespace {

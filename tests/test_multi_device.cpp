@@ -1,16 +1,18 @@
 // Several devices sharing one render, on PoCL's two CPU devices (POCL_DEVICES is set
-// before OpenCL loads): both devices work, the merged image is the single-device
-// estimator (the same samples: equal to float rounding for one seed, statistically equal
-// across seeds), deterministic, and a device that fails mid-render loses no work and
-// counts none twice.
+// before OpenCL loads): both devices work, the merged image is the single-device image
+// (bitwise for one seed, statistically equal across seeds), deterministic, and a device
+// that fails mid-render loses no work and counts none twice.
 #include <gtest/gtest.h>
 
+#include <OpenImageIO/imageio.h>
+
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "multi_device.h"
-#include "scene_loader.h"
+#include "render/render.h"
+#include "scene/scene_loader.h"
 #include "test_support.h"
 
 namespace fh {
@@ -37,7 +39,7 @@ struct TwoDevices : ::testing::Test {
 TEST_F(TwoDevices, BothWorkAndTheMergeEqualsOneDevicesSamples) {
   const auto all = devices();
   ASSERT_GE(all.size(), 2u);
-  const MultiDeviceResult multi = renderOnDevices(all, scene, bvh, scene.camera, settings);
+  const RenderResult multi = render(all, scene, bvh, scene.camera, settings);
   ASSERT_TRUE(multi.complete);
   EXPECT_EQ(multi.stats.samples, 24u * 24u * 64u);
   uint64_t total = 0;
@@ -48,25 +50,22 @@ TEST_F(TwoDevices, BothWorkAndTheMergeEqualsOneDevicesSamples) {
   }
   EXPECT_EQ(total, multi.stats.samples);
 
-  DeviceContext dc(all[0]);
-  PathTracer single(dc, scene, bvh, scene.camera, settings);
-  const Film one = single.render();
-  // The same global samples whoever renders them: only the summation differs (the
-  // device sums in float, the merge in double).
-  for (size_t i = 0; i < one.sum.size(); ++i)
-    ASSERT_NEAR(multi.film.sum[i], one.sum[i], 1e-4 * std::max(1.0f, std::fabs(one.sum[i]))) << i;
+  // One render path: one device is a pool of one, merging the same global passes in the
+  // same order and precision, so the image is the same to the last bit.
+  const RenderResult one = render({all[0]}, scene, bvh, scene.camera, settings);
+  EXPECT_EQ(one.stats.devices.size(), 1u);
+  EXPECT_EQ(multi.film.sum, one.film.sum);
+  EXPECT_EQ(multi.film.sumSq, one.film.sumSq);
 }
 
 TEST_F(TwoDevices, MergedImageMatchesAnIndependentSingleDeviceRender) {
   const auto all = devices();
   ASSERT_GE(all.size(), 2u);
   settings.spp = 128;
-  const MultiDeviceResult multi = renderOnDevices(all, scene, bvh, scene.camera, settings);
-  DeviceContext dc(all[0]);
+  const RenderResult multi = render(all, scene, bvh, scene.camera, settings);
   RenderSettings other = settings;
   other.seed = 10;
-  PathTracer single(dc, scene, bvh, scene.camera, other);
-  const Film one = single.render();
+  const Film one = render({all[0]}, scene, bvh, scene.camera, other).film;
   // Image means over 4x4 blocks, z-tests with the two renders' own variances.
   double diff = 0, var = 0;
   int outliers = 0, blocks = 0;
@@ -92,17 +91,17 @@ TEST_F(TwoDevices, MergedImageMatchesAnIndependentSingleDeviceRender) {
 
 TEST_F(TwoDevices, DeterministicForASeedAndDeviceList) {
   const auto all = devices();
-  const MultiDeviceResult a = renderOnDevices(all, scene, bvh, scene.camera, settings);
-  const MultiDeviceResult b = renderOnDevices(all, scene, bvh, scene.camera, settings);
+  const RenderResult a = render(all, scene, bvh, scene.camera, settings);
+  const RenderResult b = render(all, scene, bvh, scene.camera, settings);
   EXPECT_EQ(a.film.sum, b.film.sum);
   EXPECT_EQ(a.film.sumSq, b.film.sumSq);
 }
 
 TEST_F(TwoDevices, AFailingDeviceLosesNothingAndCountsNothingTwice) {
   const auto all = devices();
-  const MultiDeviceResult reference = renderOnDevices(all, scene, bvh, scene.camera, settings);
+  const RenderResult reference = render(all, scene, bvh, scene.camera, settings);
   setenv("FREDHOLM_FAIL_DEVICE", "1:3", 1);
-  const MultiDeviceResult failed = renderOnDevices(all, scene, bvh, scene.camera, settings);
+  const RenderResult failed = render(all, scene, bvh, scene.camera, settings);
   unsetenv("FREDHOLM_FAIL_DEVICE");
   ASSERT_TRUE(failed.complete);
   EXPECT_NE(failed.stats.devices[1].error.find("simulated failure"), std::string::npos);
@@ -115,7 +114,7 @@ TEST_F(TwoDevices, AFailingDeviceLosesNothingAndCountsNothingTwice) {
 TEST_F(TwoDevices, WhenEveryDeviceFailsTheImageSoFarIsKept) {
   const auto all = devices();
   setenv("FREDHOLM_FAIL_DEVICE", "0:2", 1);
-  const MultiDeviceResult r = renderOnDevices({all[0]}, scene, bvh, scene.camera, settings);
+  const RenderResult r = render({all[0]}, scene, bvh, scene.camera, settings);
   unsetenv("FREDHOLM_FAIL_DEVICE");
   EXPECT_FALSE(r.complete);
   EXPECT_EQ(r.stats.samples, 2u * 24u * 24u);
@@ -155,6 +154,47 @@ TEST(MultiDeviceCli, FailureIsReportedAndTheRenderFinishes) {
   EXPECT_EQ(r.exitCode, 0) << r.output;
   EXPECT_NE(r.output.find("fredholm: warning: device"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("the other devices rendered its passes"), std::string::npos) << r.output;
+}
+
+// --device means the same in every command: render uses every device selected and names
+// each that contributed (metadata, stats, summary); bench measures each, a row per device;
+// --aov, which draws on one device, refuses a spec that selects several.
+TEST(MultiDeviceCli, EveryCommandTakesEveryDeviceTheSpecSelects) {
+  const std::string dir = test::tempDir("multi");
+  const std::string env = "POCL_DEVICES='pthread basic'";
+  const auto r = test::runFredholm(
+      "render --device all --width 32 --height 32 --spp 8 -o " + dir + "/m.exr --stats " + dir + "/s.json", env);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  auto image = OIIO::ImageInput::open(dir + "/m.exr");
+  ASSERT_TRUE(image);
+  const std::string named = image->spec().get_string_attribute("fredholm:device");
+  std::ifstream statsFile(dir + "/s.json");
+  const auto stats = nlohmann::json::parse(statsFile);
+  ASSERT_EQ(stats["devices"].size(), 2u);
+  for (const auto& d : stats["devices"]) {
+    const std::string name = d["name"];
+    EXPECT_NE(named.find(name), std::string::npos) << named << " lacks " << name;
+    EXPECT_NE(r.output.find(name), std::string::npos) << "the summary line lacks " << name << ": " << r.output;
+  }
+
+  const auto bench = test::runFredholm(
+      "bench cornell --device all --width 16 --height 16 --repeats 1 --json " + dir + "/b.json", env);
+  ASSERT_EQ(bench.exitCode, 0) << bench.output;
+  std::ifstream benchFile(dir + "/b.json");
+  const auto doc = nlohmann::json::parse(benchFile);
+  ASSERT_EQ(doc["devices"].size(), 2u);
+  for (const auto& device : doc["devices"]) {
+    int rows = 0;
+    for (const auto& record : doc["records"]) rows += record["device"] == device;
+    EXPECT_EQ(rows, 3) << device << ": one row per ray kind (primary, bounce, shadow)";
+  }
+
+  const auto aov = test::runFredholm("render --aov albedo --device all -o " + dir + "/a.png", env);
+  EXPECT_EQ(aov.exitCode, 1);
+  EXPECT_NE(aov.output.find("fredholm: error: --aov renders on one device"), std::string::npos) << aov.output;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/a.png"));
+  EXPECT_EQ(test::runFredholm("render --aov albedo --device 1 --width 8 --height 8 -o " + dir + "/b.png", env).exitCode,
+            0);
 }
 
 }  // namespace

@@ -16,8 +16,8 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 
-#include "closed_form.h"
-#include "path_tracer.h"
+#include "render/render.h"
+#include "scene/closed_form.h"
 #include "scene_builder.h"
 #include "test_support.h"
 
@@ -50,9 +50,8 @@ Rendered render(const Scene& scene, const Camera& camera, Method method, int siz
   s.wavefront = wavefront;
   s.env = env;
   s.maxDepth = maxDepth;
-  PathTracer tracer(dc, scene, bvh, camera, s);
-  Rendered r{tracer.render(), tracer.stats()};
-  return r;
+  RenderResult r = fh::render(dc, scene, bvh, camera, s);
+  return {r.film, r.stats};
 }
 
 double luminanceMean(const Film& f, size_t p) {
@@ -88,7 +87,10 @@ void expectMatches(const Film& f, const std::function<double(size_t)>& expected,
           const double e = expected(p);
           if (std::isnan(e)) continue;
           diff += luminanceMean(f, p) - e;
-          var += pixelVariance(f, p);
+          // Samples are computed in single precision: where the estimator has (nearly) zero
+          // variance, rounding of a few ulps per sample is all that is left, and the film's
+          // double-precision sums would otherwise call it significant.
+          var += pixelVariance(f, p) + std::pow(0x1p-20 * e, 2);
           ++n;
         }
       if (n == 0) continue;
@@ -251,14 +253,14 @@ TEST(PathTracer, SpecializedAndAllFeatureKernelsAgree) {
   RenderSettings s;
   s.width = s.height = 16;
   s.spp = 64;
-  PathTracer specialized(dc, scene, bvh, scene.camera, s);
-  const Film a = specialized.render();
+  const RenderResult specialized = fh::render(dc, scene, bvh, scene.camera, s);
   s.allFeatures = true;
-  PathTracer everything(dc, scene, bvh, scene.camera, s);
-  const Film b = everything.render();
-  EXPECT_EQ(specialized.stats().bounceRays, everything.stats().bounceRays);
+  const RenderResult everything = fh::render(dc, scene, bvh, scene.camera, s);
+  EXPECT_EQ(specialized.stats.bounceRays, everything.stats.bounceRays);
+  const Film &a = specialized.film, &b = everything.film;
   double maxDiff = 0;
-  for (size_t i = 0; i < a.sum.size(); ++i) maxDiff = std::max(maxDiff, double(std::fabs(a.sum[i] - b.sum[i])) / std::max(1.0f, std::fabs(a.sum[i])));
+  for (size_t i = 0; i < a.sum.size(); ++i)
+    maxDiff = std::max(maxDiff, std::fabs(a.sum[i] - b.sum[i]) / std::max(1.0, std::fabs(a.sum[i])));
   EXPECT_LT(maxDiff, 1e-3);
 }
 
@@ -298,7 +300,7 @@ TEST(PathTracer, StatsCountRaysAndSamples) {
   EXPECT_EQ(r.stats.cameraRays, r.stats.samples);
   EXPECT_GT(r.stats.bounceRays, 0u);
   EXPECT_GT(r.stats.shadowRays, 0u);
-  EXPECT_GT(r.stats.kernelSeconds.at("shade"), 0.0);
+  EXPECT_GT(r.stats.stageSeconds.at("shade"), 0.0);
   const auto json = nlohmann::json::parse(statsJson(r.stats, RenderSettings{}));
   for (const char* key : {"samples", "seconds", "samples_per_second", "nonfinite_samples", "devices"})
     EXPECT_TRUE(json.contains(key)) << key;

@@ -13,7 +13,7 @@
 #include <sstream>
 #include <thread>
 
-#include "kernel_sources.h"
+#include "device/kernel_sources.h"
 #include "program_catalog.h"
 #include "test_support.h"
 

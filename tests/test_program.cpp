@@ -5,10 +5,10 @@
 #include <cstdlib>
 #include <random>
 
-#include "devices.h"
-#include "kernel_sources.h"
-#include "program.h"
-#include "ray_caster.h"
+#include "accel/ray_caster.h"
+#include "device/devices.h"
+#include "device/kernel_sources.h"
+#include "device/program.h"
 #include "test_support.h"
 
 namespace fh {

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <functional>
 
-#include "render_aov.h"
-#include "scene_loader.h"
+#include "base/vec.h"
+#include "render/render_aov.h"
+#include "scene/scene_loader.h"
 #include "test_support.h"
-#include "vec.h"
 
 namespace fh {
 namespace {

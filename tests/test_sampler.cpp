@@ -7,9 +7,9 @@
 #include <cmath>
 #include <set>
 
-#include "kernel_sources.h"
-#include "program.h"
-#include "ray_caster.h"
+#include "accel/ray_caster.h"
+#include "device/kernel_sources.h"
+#include "device/program.h"
 #include "test_support.h"
 
 namespace fh {

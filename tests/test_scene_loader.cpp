@@ -5,8 +5,8 @@
 #include <cmath>
 #include <filesystem>
 
-#include "error.h"
-#include "scene_loader.h"
+#include "base/error.h"
+#include "scene/scene_loader.h"
 #include "test_support.h"
 
 namespace fh {

@@ -10,7 +10,7 @@
 #include <fstream>
 #include <vector>
 
-#include "image_io.h"
+#include "image/image_io.h"
 
 namespace fh::test {
 namespace fs = std::filesystem;

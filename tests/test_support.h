@@ -31,7 +31,7 @@ std::string writeFeatureScene(const std::string& dir);
 
 }  // namespace fh::test
 
-#include "scene.h"
+#include "scene/scene.h"
 
 namespace fh::test {
 

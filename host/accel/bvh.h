@@ -1,0 +1,44 @@
+// The bounding volume hierarchy: a binary tree built with the binned surface area
+// heuristic, collapsed into 8-wide nodes (kernels/types.h) for float8 traversal.
+#pragma once
+#include <cstddef>
+#include <vector>
+
+#include "kernels/types.h"
+#include "scene/scene.h"
+
+namespace fh {
+
+struct BvhStats {
+  size_t binaryNodes = 0;
+  size_t wideNodes = 0;
+  size_t leaves = 0;
+  int depth = 0;  // wide levels from the root to the deepest leaf
+  double buildSeconds = 0.0;
+};
+
+struct Bvh {
+  std::vector<gpu::Bvh8Node> nodes;
+  std::vector<gpu::TriangleBlock8> blocks;  // one per leaf, for the intersect kernels
+  std::vector<float> triangles;  // 12 floats per triangle in BVH order: v0.xyz id, v1.xyz 0, v2.xyz 0
+  std::vector<unsigned> order;   // order[k]: the file-order id of the k-th triangle in BVH order
+  BvhStats stats;
+
+  // Device memory of the structure the intersect kernels read (nodes and leaf blocks).
+  size_t bytes() const { return nodes.size() * sizeof(gpu::Bvh8Node) + blocks.size() * sizeof(gpu::TriangleBlock8); }
+  // Entries the traversal stack needs: each wide level defers up to 7 children.
+  int traversalStack() const { return 7 * stats.depth + 1; }
+};
+
+Bvh buildBvh(const Scene& scene);
+
+// Puts per-triangle data in BVH order: out[k] = in[order[k]] (stride values per triangle).
+template <typename T>
+std::vector<T> toBvhOrder(const std::vector<T>& in, const std::vector<unsigned>& order, size_t stride = 1) {
+  std::vector<T> out(order.size() * stride);
+  for (size_t k = 0; k < order.size(); ++k)
+    for (size_t j = 0; j < stride; ++j) out[k * stride + j] = in[order[k] * stride + j];
+  return out;
+}
+
+}  // namespace fh

@@ -1,0 +1,57 @@
+// The ray-casting operation on one device: the scene's BVH in device memory and the
+// intersect kernels (closest hit and any hit) over queues of rays.
+#pragma once
+#include <string>
+
+#include "accel/bvh.h"
+#include "device/device_context.h"
+#include "device/program.h"
+
+namespace fh {
+
+// The intersect kernels for a BVH that needs `traversalOptions` (its stack depth).
+ProgramSpec intersectProgram(const std::string& traversalOptions);
+
+// The BVH in one device's memory, for any program that traverses it.
+class DeviceBvh {
+ public:
+  DeviceBvh(DeviceContext& dc, const Bvh& bvh);
+  const cl::Buffer& nodes() const { return nodes_; }
+  const cl::Buffer& blocks() const { return blocks_; }
+  // Triangles in BVH order (three float4 each), for turning hits into surface points.
+  const cl::Buffer& triangles() const { return triangles_; }
+  // Build options every program that traverses this BVH must use.
+  const std::string& traversalOptions() const { return options_; }
+
+ private:
+  std::string options_;
+  cl::Buffer nodes_, blocks_, triangles_;
+};
+
+// Ray casting as an operation of its own: the BVH and the intersect kernels over arrays
+// of rays (the bench, --aov, tests). The path tracer traverses the BVH inside its stages.
+class RayCaster {
+ public:
+  RayCaster(DeviceContext& dc, const Bvh& bvh);
+
+  // hits[i] = (t, b1, b2, BVH-order triangle bits or -1) for rays (org.xyz+tmin, dir.xyz+tmax).
+  void intersectClosest(const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& hits, unsigned count,
+                        cl::Event* event = nullptr);
+  // occluded[i] = 1 if anything lies on [tmin, tmax), else 0.
+  void intersectAny(const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& occluded, unsigned count,
+                    cl::Event* event = nullptr);
+
+  const cl::Buffer& nodes() const { return bvh_.nodes(); }
+  const cl::Buffer& blocks() const { return bvh_.blocks(); }
+  const cl::Buffer& triangles() const { return bvh_.triangles(); }
+  const std::string& traversalOptions() const { return bvh_.traversalOptions(); }
+  const ProgramBuildInfo& buildInfo() const { return buildInfo_; }
+
+ private:
+  DeviceContext& dc_;
+  DeviceBvh bvh_;
+  ProgramBuildInfo buildInfo_;
+  cl::Kernel closest_, any_;
+};
+
+}  // namespace fh

@@ -1,0 +1,20 @@
+// The scenes `fredholm bench` measures, also reachable as `fredholm render bench:NAME`.
+#pragma once
+#include <string>
+
+#include "scene/scene.h"
+
+namespace fh {
+
+// A bench scene by name (cornell, bunny-box, sponza, bunnies-1m: the generated scene of
+// about 1.1M triangles) or an OBJ path; `name` is what the bench reports it as.
+Scene benchScene(const std::string& spec, std::string& name);
+
+// The directory of the shared test scenes: $FREDHOLM_SCENES, else ../shared/scenes
+// beside the source tree.
+std::string sharedScenesDir();
+
+// A scene without emitters (Sponza) gets a stand-in light so shadow rays can be timed.
+void addBenchLightIfNone(Scene& scene);
+
+}  // namespace fh

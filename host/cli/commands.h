@@ -1,0 +1,55 @@
+// The subcommands behind `fredholm`: each takes its parsed options and returns the exit
+// status, throwing fh::Error for anything the user should fix (main prints it as one
+// `fredholm: error:` line).
+#pragma once
+#include <optional>
+#include <string>
+
+#include "scene/scene.h"
+
+namespace fh {
+
+struct RenderOptions {
+  std::string scene;
+  std::string output;
+  bool force = false;
+  int width = 512, height = 512, spp = 0;
+  double seconds = 0.0;
+  std::string method = "mis", filter = "box", env, statsFile;
+  int maxDepth = 64;
+  size_t wavefront = 0;
+  bool allFeatures = false;
+  unsigned seed = 1;
+  std::string cameraFile, eye, target, up;
+  std::optional<float> fov;
+  std::string aov;
+  std::string device;
+};
+int runRender(RenderOptions o);
+
+int runDevices(const std::string& spec);
+
+struct CompareOptions {
+  std::string image, reference;
+  int block = 1;
+};
+int runCompare(const CompareOptions& o);
+
+struct ReferenceOptions {
+  std::string scene, output;
+  int width = 128, height = 128;
+  bool force = false;
+};
+int runReference(const ReferenceOptions& o);
+
+struct ExportOptions {
+  std::string scene, output;
+  bool force = false;
+};
+int runExport(const ExportOptions& o);
+
+// An OBJ path, builtin:NAME, bench:NAME (a bench scene), or "" for the Cornell box.
+Scene loadSceneSpec(const std::string& spec);
+void printWarnings(const Scene& scene);
+
+}  // namespace fh

@@ -1,0 +1,54 @@
+// Parsing flag values.
+#include "cli/flags.h"
+
+#include <sstream>
+#include <stdexcept>
+
+#include "base/error.h"
+#include "base/vec.h"
+
+namespace fh {
+
+Method parseMethod(const std::string& name) {
+  if (name == "pt") return Method::PT;
+  if (name == "nee") return Method::NEE;
+  if (name == "mis") return Method::MIS;
+  throw Error("--method '" + name + "': unknown method (use pt, nee or mis)");
+}
+
+PixelFilter parseFilter(const std::string& name) {
+  if (name == "box") return PixelFilter::Box;
+  if (name == "gaussian") return PixelFilter::Gaussian;
+  if (name == "blackman-harris") return PixelFilter::BlackmanHarris;
+  throw Error("--filter '" + name + "': unknown filter (use box, gaussian or blackman-harris)");
+}
+
+Aov parseAov(const std::string& name) {
+  if (name == "albedo") return Aov::Albedo;
+  if (name == "normal") return Aov::Normal;
+  if (name == "depth") return Aov::Depth;
+  throw Error("--aov '" + name + "': unknown output (use albedo, normal or depth)");
+}
+
+std::array<float, 3> parseVec3Flag(const std::string& flag, const std::string& text) {
+  std::array<float, 3> v{};
+  std::istringstream in(text);
+  std::string item;
+  int n = 0;
+  while (std::getline(in, item, ',')) {
+    if (n == 3) throw Error(flag + " '" + text + "': expected three comma-separated numbers");
+    try {
+      size_t used = 0;
+      v[size_t(n)] = std::stof(item, &used);
+      if (item.find_first_not_of(" \t", used) != std::string::npos) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw Error(flag + " '" + text + "': '" + item + "' is not a number");
+    }
+    ++n;
+  }
+  if (n != 3) throw Error(flag + " '" + text + "': expected three comma-separated numbers");
+  if (!isFinite(v)) throw Error(flag + " '" + text + "': values must be finite");
+  return v;
+}
+
+}  // namespace fh

@@ -1,0 +1,17 @@
+// Flag values that are more than a number: each parser throws fh::Error naming its flag.
+#pragma once
+#include <array>
+#include <string>
+
+#include "render/render_aov.h"
+#include "render/settings.h"
+
+namespace fh {
+
+Method parseMethod(const std::string& name);      // --method pt|nee|mis
+PixelFilter parseFilter(const std::string& name);  // --filter box|gaussian|blackman-harris
+Aov parseAov(const std::string& name);             // --aov albedo|normal|depth
+// "x,y,z": three finite numbers (--eye, --target, --up, --env).
+std::array<float, 3> parseVec3Flag(const std::string& flag, const std::string& text);
+
+}  // namespace fh

@@ -1,0 +1,152 @@
+// The fredholm command line: flags for `devices`, `render`, `bench`, `compare`,
+// `reference` and `export`, parsed by CLI11 and handed to the subcommands (commands.h).
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+
+#include "bench/bench.h"
+#include "cli/commands.h"
+#include "device/program.h"
+#ifdef FREDHOLM_HAVE_EMBREE
+#include "embree_tracer.h"
+#endif
+
+using namespace fh;
+
+// --device takes the same SPEC in every command (device/devices.h).
+constexpr const char* kDeviceSpec = "index (0), list (0,1), type (cpu, gpu, all) or name";
+
+namespace {
+
+CLI::App* addDevices(CLI::App& app, std::string& o) {
+  CLI::App* devices = app.add_subcommand("devices", "List OpenCL platforms and devices");
+  devices->add_option("--device", o, std::string("Show only these devices: ") + kDeviceSpec);
+  return devices;
+}
+
+CLI::App* addRender(CLI::App& app, RenderOptions& o) {
+  CLI::App* rendering = app.add_subcommand("render", "Render an OBJ scene (default: the built-in Cornell box)");
+  rendering->add_option("scene", o.scene, "OBJ file");
+  rendering->add_option("-o,--output", o.output,
+                        "Output image (.exr .hdr .pfm .png .jpg); default fredholm.png, or the next free "
+                        "fredholm-N.png");
+  rendering->add_flag("--force", o.force, "Overwrite an existing output file");
+  rendering->add_option("--width", o.width, "Image width in pixels")->capture_default_str();
+  rendering->add_option("--height", o.height, "Image height in pixels")->capture_default_str();
+  rendering->add_option("--spp", o.spp, "Samples per pixel (default 64; with --time, the most to take)");
+  rendering->add_option("--time", o.seconds, "Time budget in seconds (finishes the pass running then)");
+  rendering->add_option("--method", o.method, "pt (BRDF sampling), nee (light sampling) or mis (both)")
+      ->capture_default_str();
+  rendering->add_option("--max-depth", o.maxDepth, "Most bounces (Russian roulette ends most paths sooner)")
+      ->capture_default_str();
+  rendering->add_option("--env", o.env, "Constant environment radiance R,G,B (default black)");
+  rendering->add_option("--filter", o.filter, "Pixel filter: box, gaussian or blackman-harris")
+      ->capture_default_str();
+  rendering->add_option("--wavefront", o.wavefront, "Paths in flight (default: chosen for the device)");
+  rendering->add_option("--stats", o.statsFile, "Write render statistics as JSON");
+  rendering->add_flag("--all-features", o.allFeatures,
+                      "Compile every material feature, not only the scene's (to measure specialization)");
+  rendering->add_option("--seed", o.seed, "Random seed")->capture_default_str();
+  rendering->add_option("--camera", o.cameraFile, "Camera JSON {eye,target,up,fov_y_deg}");
+  rendering->add_option("--eye", o.eye, "Camera position x,y,z");
+  rendering->add_option("--target", o.target, "Point the camera looks at x,y,z");
+  rendering->add_option("--up", o.up, "Camera up vector x,y,z");
+  rendering->add_option("--fov", o.fov, "Vertical field of view in degrees");
+  rendering->add_option("--aov", o.aov, "Debug view instead of light transport: albedo, normal or depth");
+  rendering->add_option("--device", o.device,
+                        std::string("Devices sharing the render (--aov: one): ") + kDeviceSpec);
+  return rendering;
+}
+
+CLI::App* addBench(CLI::App& app, BenchOptions& o) {
+  CLI::App* benching = app.add_subcommand("bench", "Measure ray-casting throughput (Mrays/s) per scene and ray kind");
+  benching->add_option("scenes", o.scenes,
+                       "Scenes: cornell, bunny-box, sponza, bunnies-1m, or OBJ files (default: all four)");
+  benching->add_option("--device", o.device,
+                       std::string("Devices to measure, a row each: ") + kDeviceSpec);
+  benching->add_option("--json", o.jsonPath, "Write the results as JSON");
+  benching->add_flag("--force", o.force, "Overwrite an existing --json file");
+  benching->add_option("--width", o.width, "Primary rays per batch: width x height")->capture_default_str();
+  benching->add_option("--height", o.height, "Primary rays per batch: width x height")->capture_default_str();
+  benching->add_option("--repeats", o.repeats, "Timed runs after a warm-up (median reported)")
+      ->capture_default_str();
+  benching->add_option("--threads", o.threads, "Threads for the external tracer")->capture_default_str();
+#ifdef FREDHOLM_HAVE_EMBREE
+  o.external = makeEmbreeTracer;
+#endif
+  return benching;
+}
+
+CLI::App* addCompare(CLI::App& app, CompareOptions& o) {
+  CLI::App* comparing = app.add_subcommand(
+      "compare", "Error of an image against a reference as JSON: relMSE, RMSE, MAE and each image's channel means");
+  comparing->add_option("image", o.image, "Rendered image (.exr .hdr .pfm ...)")->required();
+  comparing->add_option("reference", o.reference, "Reference image of the same size")->required();
+  comparing->add_option("--block", o.block, "Average KxK pixel blocks of both first (K divides the size)")
+      ->capture_default_str();
+  return comparing;
+}
+
+CLI::App* addReference(CLI::App& app, ReferenceOptions& o) {
+  CLI::App* referencing = app.add_subcommand("reference", "Write the exact image of a closed-form scene (builtin:NAME)");
+  referencing->add_option("scene", o.scene, "builtin:plane-under-light")->required();
+  referencing->add_option("-o,--output", o.output, "Output image")->required();
+  referencing->add_option("--width", o.width, "Image width")->capture_default_str();
+  referencing->add_option("--height", o.height, "Image height")->capture_default_str();
+  referencing->add_flag("--force", o.force, "Overwrite an existing output file");
+  return referencing;
+}
+
+CLI::App* addExport(CLI::App& app, ExportOptions& o) {
+  CLI::App* exporter = app.add_subcommand(
+      "export", "Write a scene (an OBJ, or builtin:NAME) as OBJ + MTL + camera.json, e.g. for another renderer");
+  exporter->add_option("scene", o.scene, "OBJ file or builtin:plane-under-light (default: the Cornell box)");
+  exporter->add_option("-o,--output", o.output, "Output .obj (the .mtl and .camera.json go beside it)")
+      ->required();
+  exporter->add_flag("--force", o.force, "Overwrite existing files");
+  return exporter;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"fredholm: an OpenCL wavefront path tracer"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "fredholm " FREDHOLM_VERSION);
+  std::string devicesSpec;
+  RenderOptions render;
+  BenchOptions bench;
+  CompareOptions compare;
+  ReferenceOptions reference;
+  ExportOptions exporting;
+  CLI::App* devices = addDevices(app, devicesSpec);
+  CLI::App* rendering = addRender(app, render);
+  CLI::App* benching = addBench(app, bench);
+  CLI::App* comparing = addCompare(app, compare);
+  CLI::App* referencing = addReference(app, reference);
+  CLI::App* exporter = addExport(app, exporting);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    if (*devices) return runDevices(devicesSpec);
+    if (*rendering) return runRender(render);
+    if (*benching) return runBench(bench);
+    if (*referencing) return runReference(reference);
+    if (*comparing) return runCompare(compare);
+    if (*exporter) return runExport(exporting);
+  } catch (const BuildError& e) {
+    std::cerr << "fredholm: error: " << e.what() << "\n";
+    return 1;
+  } catch (const Error& e) {
+    std::cerr << "fredholm: error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "fredholm: internal error: " << e.what() << "\n";
+    return 3;
+  }
+  return 0;
+}

@@ -1,0 +1,171 @@
+// `fredholm render`: flags checked before any work, then scene, camera, BVH, one render on
+// every device --device selects, and the image with its metadata.
+#include <chrono>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "base/vec.h"
+#include "cli/commands.h"
+#include "cli/flags.h"
+#include "device/devices.h"
+#include "image/image_io.h"
+#include "render/render.h"
+#include "render/render_aov.h"
+#include "render/wavefront.h"
+
+namespace fh {
+namespace {
+
+std::string formatSeconds(double s) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(2) << s;
+  return out.str();
+}
+
+// --camera FILE, else the scene's sidecar, else framing; then --eye/--target/--up/--fov override.
+Camera chooseCamera(const RenderOptions& o, const Scene& scene) {
+  Camera camera;
+  bool framed = false;
+  if (!o.cameraFile.empty()) {
+    camera = loadCameraJson(o.cameraFile);
+  } else if (scene.hasCamera) {
+    camera = scene.camera;
+  } else {
+    Vec3f lo, hi;
+    scene.bounds(lo, hi);
+    camera = frameBounds(lo, hi);
+    framed = true;
+    if (o.eye.empty() || o.target.empty())
+      std::cerr << "fredholm: no camera given (--camera, --eye/--target, or a .camera.json beside the OBJ): "
+                   "framing the scene's bounds\n";
+  }
+  if (!o.eye.empty()) camera.eye = parseVec3Flag("--eye", o.eye);
+  if (!o.target.empty()) camera.target = parseVec3Flag("--target", o.target);
+  if (!o.up.empty()) camera.up = parseVec3Flag("--up", o.up);
+  if (o.fov) camera.fovYDeg = *o.fov;
+  if (framed && (!isFinite(camera.eye) || !isFinite(camera.target)))
+    throw Error(scene.sourcePath + ": the scene's bounds are too large to frame a camera; give --camera or "
+                                   "--eye/--target");
+  validateCamera(camera, o.fov ? "--fov" : "camera");
+  return camera;
+}
+
+// Every flag that does not need the scene, checked; 64 spp by default (4 for --aov), or
+// with --time and no --spp as many as the time allows (a render numbers its samples in
+// 32 bits, so at most that many).
+RenderSettings settingsFrom(const RenderOptions& o) {
+  RenderSettings s;
+  s.method = parseMethod(o.method);
+  s.filter = parseFilter(o.filter);
+  if (!o.env.empty()) s.env = parseVec3Flag("--env", o.env);
+  if (o.width <= 0 || o.height <= 0) throw Error("--width/--height must be positive");
+  // Pixels are indexed in 32 bits on the device, with room for several pass buffers.
+  if (uint64_t(o.width) * uint64_t(o.height) > (uint64_t(1) << 28))
+    throw Error("--width/--height: " + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                " is more than the 268 million pixels fredholm renders in one image");
+  if (o.spp < 0) throw Error("--spp must be positive");
+  if (o.seconds < 0) throw Error("--time must be positive");
+  if (o.maxDepth < 1) throw Error("--max-depth must be at least 1");
+  if (o.wavefront != 0 && o.wavefront < kLocalSize) throw Error("--wavefront must be at least 64");
+  const uint64_t pixels = uint64_t(o.width) * uint64_t(o.height);
+  s.width = o.width;
+  s.height = o.height;
+  s.spp = o.spp > 0 ? o.spp
+                    : (o.seconds > 0 ? int(std::min<uint64_t>(1 << 20, 0xFFFFFFFFull / pixels))
+                                     : (o.aov.empty() ? 64 : 4));
+  s.seconds = o.seconds;
+  s.maxDepth = o.maxDepth;
+  s.seed = o.seed;
+  s.wavefront = o.wavefront;
+  s.allFeatures = o.allFeatures;
+  s.progress = true;
+  return s;
+}
+
+// --aov: first-hit albedo, normal or depth, on one device (runRender checks there is one).
+RenderResult renderDebugView(const RenderOptions& o, const std::vector<DeviceInfo>& devices, const Scene& scene,
+                             const Bvh& bvh, const Camera& camera, const RenderSettings& s) {
+  AovSettings a;
+  a.width = s.width;
+  a.height = s.height;
+  a.spp = s.spp;
+  a.seed = s.seed;
+  a.mode = parseAov(o.aov);
+  DeviceContext dc(devices[0]);
+  const Image image = renderAov(dc, scene, bvh, camera, a);
+  RenderResult r;
+  r.film = Film(s.width, s.height);
+  for (size_t p = 0; p < r.film.pixels(); ++p) {
+    for (size_t c = 0; c < 3; ++c) r.film.sum[4 * p + c] = image.rgb[3 * p + c];
+    r.film.sum[4 * p + 3] = 1.0;
+  }
+  r.stats.samples = uint64_t(s.spp) * r.film.pixels();
+  r.stats.devices.push_back({devices[0].name, r.stats.samples, 0, 0.0, 0.0, ""});
+  return r;
+}
+
+void reportDevices(const RenderResult& r) {
+  for (const auto& d : r.stats.devices)
+    if (!d.error.empty())
+      std::cerr << "fredholm: warning: device " << d.name << " failed: " << d.error
+                << (r.complete ? "; the other devices rendered its passes" : "") << "\n";
+  if (r.stats.nonfinite)
+    std::cerr << "fredholm: warning: " << r.stats.nonfinite << " samples were NaN or infinite and dropped\n";
+}
+
+}  // namespace
+
+int runRender(RenderOptions o) {
+  const RenderSettings settings = settingsFrom(o);
+  if (!o.aov.empty()) parseAov(o.aov);
+  // An explicit -o is never overwritten without --force; the default name steps aside.
+  if (o.output.empty()) o.output = firstFreeName("fredholm.png");
+  checkOutputPath(o.output, o.force);
+  if (!o.statsFile.empty()) checkOutputFile(o.statsFile, o.force, "--stats");
+  const auto devices = selectDevices(listDevices(), o.device);
+  if (!o.aov.empty() && devices.size() > 1)
+    throw Error("--aov renders on one device, and --device '" + o.device + "' selects " +
+                std::to_string(devices.size()) + "; pick one (e.g. --device " + std::to_string(devices[0].index) +
+                ")");
+
+  const Scene scene = loadSceneSpec(o.scene);
+  printWarnings(scene);
+  const Camera camera = chooseCamera(o, scene);
+  const auto start = std::chrono::steady_clock::now();
+  const Bvh bvh = buildBvh(scene);
+  const bool debugView = !o.aov.empty();
+  const RenderResult r = debugView ? renderDebugView(o, devices, scene, bvh, camera, settings)
+                                   : render(devices, scene, bvh, camera, settings);
+  const std::string method = debugView ? "aov:" + o.aov : methodName(settings.method);
+  reportDevices(r);
+  if (!o.statsFile.empty() && !debugView) {
+    std::ofstream out(o.statsFile);
+    out << statsJson(r.stats, settings) << "\n";
+    if (!out) throw Error("--stats '" + o.statsFile + "': cannot write");
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double spp = double(r.stats.samples) / double(r.film.pixels());
+  const std::string devicesUsed = r.stats.contributors();
+  std::map<std::string, std::string> metadata = {{"scene", scene.sourcePath}, {"spp", formatSeconds(spp)}, {"method", method},
+                            {"device", devicesUsed}, {"seed", std::to_string(o.seed)},
+                            {"seconds", formatSeconds(seconds)}, {"filter", o.filter},
+                            {"max_depth", std::to_string(o.maxDepth)}};
+  if (!r.complete) {
+    metadata["incomplete"] = "every device failed";
+    writeImage(o.output, r.film.image(), metadata);
+    throw Error("every device failed before the render was complete; wrote the " +
+                std::to_string(r.stats.samples / r.film.pixels()) + " passes finished so far to " + o.output);
+  }
+  writeImage(o.output, r.film.image(), metadata);
+  std::cerr << "fredholm: rendered " << scene.sourcePath << " (" << scene.triangleCount() << " triangles, "
+            << scene.lights.size() << " emissive; " << (o.allFeatures ? "all features" : sceneFeatures(scene).describe())
+            << ") with " << method << ", " << o.width << "x" << o.height << ", " << spp << " spp on " << devicesUsed
+            << " in " << formatSeconds(seconds) << " s\n";
+  std::cout << "wrote " << o.output << "\n";
+  return 0;
+}
+
+}  // namespace fh

@@ -1,0 +1,73 @@
+// Every struct the host shares with the kernels (kernels/types.h), checked in one place:
+// sizes and field offsets as OpenCL C lays them out (scalars and fixed arrays only, each
+// at its natural alignment, no padding the host could add on its own). A field added on
+// one side without the other fails the build here.
+#include <cstddef>
+
+#include "kernels/types.h"
+
+namespace fh::gpu {
+
+#define FH_LAYOUT(type, field, offset) static_assert(offsetof(type, field) == (offset), #type "." #field)
+
+static_assert(sizeof(Bvh8Node) == 224, "Bvh8Node");
+FH_LAYOUT(Bvh8Node, lo_x, 0);
+FH_LAYOUT(Bvh8Node, hi_x, 32);
+FH_LAYOUT(Bvh8Node, lo_y, 64);
+FH_LAYOUT(Bvh8Node, hi_y, 96);
+FH_LAYOUT(Bvh8Node, lo_z, 128);
+FH_LAYOUT(Bvh8Node, hi_z, 160);
+FH_LAYOUT(Bvh8Node, child, 192);
+
+static_assert(sizeof(TriangleBlock8) == 320, "TriangleBlock8");
+FH_LAYOUT(TriangleBlock8, v, 0);
+FH_LAYOUT(TriangleBlock8, id, 288);
+
+static_assert(sizeof(CameraParams) == 80, "CameraParams");
+FH_LAYOUT(CameraParams, origin, 0);
+FH_LAYOUT(CameraParams, forward, 16);
+FH_LAYOUT(CameraParams, right, 32);
+FH_LAYOUT(CameraParams, up, 48);
+FH_LAYOUT(CameraParams, width, 64);
+FH_LAYOUT(CameraParams, height, 68);
+
+static_assert(sizeof(GpuMaterial) == 80, "GpuMaterial");
+FH_LAYOUT(GpuMaterial, kd, 0);
+FH_LAYOUT(GpuMaterial, ke, 16);
+FH_LAYOUT(GpuMaterial, ks, 32);
+FH_LAYOUT(GpuMaterial, tf, 48);
+FH_LAYOUT(GpuMaterial, illum, 64);
+FH_LAYOUT(GpuMaterial, texture, 68);
+
+static_assert(sizeof(RenderParams) == 128, "RenderParams");
+FH_LAYOUT(RenderParams, camera, 0);
+FH_LAYOUT(RenderParams, env, 80);
+FH_LAYOUT(RenderParams, seed, 96);
+FH_LAYOUT(RenderParams, pixel_count, 100);
+FH_LAYOUT(RenderParams, max_depth, 104);
+FH_LAYOUT(RenderParams, rr_depth, 108);
+FH_LAYOUT(RenderParams, light_count, 112);
+FH_LAYOUT(RenderParams, filter_table_size, 116);
+FH_LAYOUT(RenderParams, filter_radius, 120);
+
+static_assert(sizeof(WavefrontCounters) == 108, "WavefrontCounters");
+FH_LAYOUT(WavefrontCounters, ray_length, 0);
+FH_LAYOUT(WavefrontCounters, shadow_length, 8);
+FH_LAYOUT(WavefrontCounters, finished_length, 12);
+FH_LAYOUT(WavefrontCounters, free_length, 16);
+FH_LAYOUT(WavefrontCounters, nonfinite, 20);
+FH_LAYOUT(WavefrontCounters, next_sample, 24);
+FH_LAYOUT(WavefrontCounters, sample_limit, 28);
+FH_LAYOUT(WavefrontCounters, new_count, 32);
+FH_LAYOUT(WavefrontCounters, new_first, 36);
+FH_LAYOUT(WavefrontCounters, new_free_top, 40);
+FH_LAYOUT(WavefrontCounters, new_queue_base, 44);
+FH_LAYOUT(WavefrontCounters, bounce_rays, 48);
+FH_LAYOUT(WavefrontCounters, shadow_rays, 56);
+FH_LAYOUT(WavefrontCounters, queued_rays, 64);
+FH_LAYOUT(WavefrontCounters, iterations, 72);
+FH_LAYOUT(WavefrontCounters, pass_done, 76);
+
+#undef FH_LAYOUT
+
+}  // namespace fh::gpu

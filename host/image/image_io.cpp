@@ -1,0 +1,158 @@
+// OpenImageIO output and the checks made before any rendering starts. A build without
+// OpenImageIO (the self-contained GPU bundle, bench/gpu/) reads and writes PFM only.
+#include "image/image_io.h"
+
+#ifdef FREDHOLM_HAVE_OIIO
+#include <OpenImageIO/imageio.h>
+#endif
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "base/error.h"
+
+namespace fh {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string extensionOf(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+// Debian 12's OpenImageIO (2.4) reads PFM but has no PFM writer, so fredholm writes it:
+// "PF", width height, a negative scale for little-endian, then rows bottom to top.
+void writePfm(const std::string& path, const Image& image) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw Error("cannot write '" + path + "'");
+  out << "PF\n" << image.width << " " << image.height << "\n-1.0\n";
+  static_assert(sizeof(float) == 4, "PFM stores 32-bit floats");
+  for (int y = image.height - 1; y >= 0; --y)
+    out.write(reinterpret_cast<const char*>(&image.rgb[size_t(y) * size_t(image.width) * 3]),
+              std::streamsize(size_t(image.width) * 3 * sizeof(float)));
+  if (!out) throw Error("cannot write '" + path + "': write failed");
+}
+
+Image readPfm(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string magic;
+  Image image;
+  double scale = 0.0;
+  if (!(in >> magic >> image.width >> image.height >> scale) || magic != "PF" || image.width <= 0 ||
+      image.height <= 0 || scale >= 0.0 || image.width > (1 << 16) || image.height > (1 << 16))
+    throw Error("cannot read '" + path + "': not a little-endian RGB PFM file");
+  in.get();  // the single whitespace byte before the pixels
+  image.rgb.resize(size_t(image.width) * size_t(image.height) * 3);
+  for (int y = image.height - 1; y >= 0; --y)
+    in.read(reinterpret_cast<char*>(&image.rgb[size_t(y) * size_t(image.width) * 3]),
+            std::streamsize(size_t(image.width) * 3 * sizeof(float)));
+  if (!in) throw Error("cannot read '" + path + "': file ends early");
+  return image;
+}
+
+}  // namespace
+
+float linearToSrgb(float x) {
+  x = std::clamp(x, 0.f, 1.f);
+  return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.f / 2.4f) - 0.055f;
+}
+
+float srgbToLinear(float x) { return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f); }
+
+ImageEncoding checkOutputPath(const std::string& path, bool force, const std::string& flag) {
+  const std::string ext = extensionOf(path);
+  ImageEncoding encoding;
+#ifndef FREDHOLM_HAVE_OIIO
+  if (ext != ".pfm")
+    throw Error(flag + " '" + path + "': this build has no OpenImageIO and writes .pfm only");
+#endif
+  if (ext == ".exr" || ext == ".hdr" || ext == ".pfm") encoding = ImageEncoding::LinearFloat;
+  else if (ext == ".png" || ext == ".jpg" || ext == ".jpeg") encoding = ImageEncoding::Srgb8;
+  else
+    throw Error(flag + " '" + path + "': unknown image extension '" + ext +
+                "' (use .exr, .hdr, .pfm, .png or .jpg)");
+  checkOutputFile(path, force, flag);
+  return encoding;
+}
+
+void checkOutputFile(const std::string& path, bool force, const std::string& flag) {
+  const fs::path parent = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
+  std::error_code ec;
+  if (!fs::is_directory(parent, ec)) throw Error(flag + " '" + path + "': directory '" + parent.string() + "' does not exist");
+  if (::access(parent.c_str(), W_OK) != 0)
+    throw Error(flag + " '" + path + "': directory '" + parent.string() + "' is not writable");
+  if (fs::is_directory(path, ec)) throw Error(flag + " '" + path + "': is a directory");
+  if (fs::exists(path, ec) && !force)
+    throw Error(flag + " '" + path + "': file exists (pass --force to overwrite it)");
+}
+
+std::string firstFreeName(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return path;
+  const fs::path p(path);
+  const std::string stem = (p.parent_path() / p.stem()).string(), ext = p.extension().string();
+  for (int i = 1;; ++i) {
+    const std::string candidate = stem + "-" + std::to_string(i) + ext;
+    if (!fs::exists(candidate, ec)) return candidate;
+  }
+}
+
+void writeImage(const std::string& path, const Image& image, const std::map<std::string, std::string>& metadata) {
+  const ImageEncoding encoding = checkOutputPath(path, true);
+  if (extensionOf(path) == ".pfm") return writePfm(path, image);
+#ifdef FREDHOLM_HAVE_OIIO
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out) throw Error("cannot write '" + path + "': " + OIIO::geterror());
+  const bool isFloat = encoding == ImageEncoding::LinearFloat;
+  OIIO::ImageSpec spec(image.width, image.height, 3, isFloat ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+  for (const auto& [key, value] : metadata) spec.attribute("fredholm:" + key, value);
+  spec.attribute("Software", "fredholm " FREDHOLM_VERSION);
+  if (!isFloat) spec.attribute("oiio:ColorSpace", "sRGB");
+  if (!out->open(path, spec)) throw Error("cannot write '" + path + "': " + out->geterror());
+  bool ok;
+  if (isFloat) {
+    ok = out->write_image(OIIO::TypeDesc::FLOAT, image.rgb.data());
+  } else {
+    std::vector<unsigned char> bytes(image.rgb.size());
+    for (size_t i = 0; i < bytes.size(); ++i)
+      bytes[i] = static_cast<unsigned char>(std::lround(255.f * linearToSrgb(image.rgb[i])));
+    ok = out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
+  }
+  if (!ok || !out->close()) throw Error("cannot write '" + path + "': " + out->geterror());
+#else
+  (void)encoding;
+  (void)metadata;
+#endif
+}
+
+Image readImage(const std::string& path) {
+#ifndef FREDHOLM_HAVE_OIIO
+  return readPfm(path);
+#else
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw Error("cannot read '" + path + "': " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  Image image;
+  image.width = spec.width;
+  image.height = spec.height;
+  std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data()))
+    throw Error("cannot read '" + path + "': " + in->geterror());
+  const bool srgb = spec.format == OIIO::TypeDesc::UINT8;
+  image.rgb.resize(size_t(spec.width) * size_t(spec.height) * 3);
+  for (size_t p = 0; p < size_t(spec.width) * size_t(spec.height); ++p)
+    for (int c = 0; c < 3; ++c) {
+      const float v = pixels[p * size_t(spec.nchannels) + size_t(std::min(c, spec.nchannels - 1))];
+      image.rgb[3 * p + size_t(c)] = srgb ? srgbToLinear(v) : v;
+    }
+  return image;
+#endif
+}
+
+}  // namespace fh

@@ -1,0 +1,186 @@
+// Uploading a scene: materials, light tables, BVH.
+#include "render/device_scene.h"
+
+#ifdef FREDHOLM_HAVE_OIIO
+#include <OpenImageIO/imageio.h>
+#endif
+
+#include <cmath>
+#include <cstring>
+#include <set>
+
+#include "base/vec.h"
+#include "image/image_io.h"
+
+namespace fh {
+namespace {
+
+float luminance(const Vec3f& c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
+
+template <typename T>
+cl::Buffer upload(DeviceContext& dc, const std::vector<T>& data, const char* what) {
+  return allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, data.size() * sizeof(T), what,
+                        data.empty() ? nullptr : data.data());
+}
+
+}  // namespace
+
+LightTable buildLightTable(const Scene& scene, const Bvh& bvh) {
+  std::vector<int> bvhIndexOf(bvh.order.size());
+  for (size_t k = 0; k < bvh.order.size(); ++k) bvhIndexOf[bvh.order[k]] = int(k);
+  LightTable table;
+  table.pdfArea.assign(scene.triangleCount(), 0.f);
+  double total = 0.0;
+  std::vector<double> power;
+  for (const Light& l : scene.lights) {
+    const double p = luminance(l.power);
+    if (!(p > 0.0)) continue;
+    power.push_back(p);
+    table.triangle.push_back(bvhIndexOf[l.triangle]);
+    total += p;
+  }
+  double running = 0.0;
+  size_t i = 0;
+  for (const Light& l : scene.lights) {
+    if (!(luminance(l.power) > 0.f)) continue;
+    running += power[i];
+    table.cdf.push_back(float(running / total));
+    table.pdfArea[size_t(table.triangle[i])] = float(power[i] / total / l.area);
+    ++i;
+  }
+  if (!table.cdf.empty()) table.cdf.back() = 1.f;  // no rounding gap at the top
+  return table;
+}
+
+std::vector<gpu::GpuMaterial> toGpuMaterials(const Scene& scene) {
+  std::vector<gpu::GpuMaterial> out(scene.materials.size());
+  for (size_t i = 0; i < out.size(); ++i) {
+    const Material& m = scene.materials[i];
+    gpu::GpuMaterial& g = out[i];
+    std::memset(&g, 0, sizeof g);
+    for (size_t c = 0; c < 3; ++c) {
+      g.kd[c] = m.kd[c];
+      g.ke[c] = m.ke[c];
+      g.ks[c] = m.ks[c];
+      g.tf[c] = m.tf[c];
+    }
+    g.ks[3] = m.ns;
+    g.tf[3] = m.ni;
+    g.illum = m.illum;
+    g.texture = m.kdTexture;
+  }
+  return out;
+}
+
+std::string SceneFeatures::buildOptions() const {
+  std::string o;
+  if (glossy) o += " -DFH_GLOSSY";
+  if (glass) o += " -DFH_GLASS";
+  if (textures) o += " -DFH_TEXTURES";
+  if (shadingNormals) o += " -DFH_SHADING_NORMALS";
+  return o;
+}
+
+std::string SceneFeatures::describe() const {
+  std::string d;
+  for (const auto& [on, name] : {std::pair{glossy, "glossy"}, {glass, "glass"}, {textures, "textures"},
+                                 {shadingNormals, "shading normals"}})
+    if (on) d += std::string(d.empty() ? "" : ", ") + name;
+  return d.empty() ? "diffuse only" : d;
+}
+
+SceneFeatures sceneFeatures(const Scene& scene) {
+  std::set<int> used(scene.triangleMaterial.begin(), scene.triangleMaterial.end());
+  SceneFeatures f;
+  for (int id : used) {
+    const Material& m = scene.materials[size_t(id)];
+    const bool specular = m.ks[0] > 0.f || m.ks[1] > 0.f || m.ks[2] > 0.f;
+    if (m.isGlass()) f.glass = true;
+    else if (specular && m.illum >= 2) f.glossy = true;
+    if (m.kdTexture >= 0 && !scene.cornerUVs.empty()) f.textures = true;
+  }
+  f.shadingNormals = !scene.cornerNormals.empty();
+  return f;
+}
+
+TextureData loadTexture(const std::string& path) {
+#ifndef FREDHOLM_HAVE_OIIO
+  throw Error(path + ": cannot read texture (this build has no OpenImageIO)");
+#else
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw Error(path + ": cannot read texture (" + OIIO::geterror() + ")");
+  const OIIO::ImageSpec& spec = in->spec();
+  const int channels = spec.nchannels;
+  std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(channels));
+  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data()))
+    throw Error(path + ": cannot read texture (" + in->geterror() + ")");
+  // 8- and 16-bit images hold sRGB-encoded colour; float images are linear already.
+  const bool srgb = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
+  TextureData t;
+  t.width = spec.width;
+  t.height = spec.height;
+  t.texels.resize(size_t(t.width) * size_t(t.height) * 4);
+  for (size_t p = 0; p < size_t(t.width) * size_t(t.height); ++p) {
+    for (int c = 0; c < 3; ++c) {
+      const float v = pixels[p * size_t(channels) + size_t(channels >= 3 ? c : 0)];
+      t.texels[4 * p + size_t(c)] = srgb ? srgbToLinear(v) : v;
+    }
+    t.texels[4 * p + 3] = 1.f;
+  }
+  return t;
+#endif
+}
+
+DeviceScene::DeviceScene(DeviceContext& dc, const Scene& scene, const Bvh& hostBvh, const SceneFeatures& f)
+    : bvh(dc, hostBvh), features(f) {
+  const LightTable lights = buildLightTable(scene, hostBvh);
+  lightCount = unsigned(lights.cdf.size());
+  triangleMaterial = upload(dc, toBvhOrder(scene.triangleMaterial, hostBvh.order), "triangle materials");
+  materials = upload(dc, toGpuMaterials(scene), "materials");
+  lightCdf = upload(dc, lights.cdf, "light CDF");
+  lightTriangle = upload(dc, lights.triangle, "light triangles");
+  lightPdfArea = upload(dc, lights.pdfArea, "light densities");
+
+  // Per-corner normals and UVs in BVH order, only where the scene uses them.
+  // A kernel compiled with a feature the scene lacks (--all-features) gets neutral data:
+  // geometric normals, zero UVs.
+  std::vector<float> cornerNormals, cornerUVs;
+  if (f.shadingNormals) {
+    std::vector<float> source = scene.cornerNormals;
+    if (source.empty()) {
+      for (size_t t = 0; t < scene.triangleCount(); ++t) {
+        const Vec3f n = cross(scene.corner(t, 1) - scene.corner(t, 0), scene.corner(t, 2) - scene.corner(t, 0));
+        for (int k = 0; k < 3; ++k) source.insert(source.end(), n.begin(), n.end());
+      }
+    }
+    const std::vector<float> ordered = toBvhOrder(source, hostBvh.order, 9);
+    for (size_t i = 0; i < ordered.size(); i += 3)
+      cornerNormals.insert(cornerNormals.end(), {ordered[i], ordered[i + 1], ordered[i + 2], 0.f});
+  }
+  if (f.textures)
+    cornerUVs = scene.cornerUVs.empty() ? std::vector<float>(6 * scene.triangleCount(), 0.f)
+                                        : toBvhOrder(scene.cornerUVs, hostBvh.order, 6);
+  normals = upload(dc, cornerNormals, "shading normals");
+  uvs = upload(dc, cornerUVs, "texture coordinates");
+
+  std::vector<float> allTexels;
+  std::vector<uint32_t> info;
+  if (f.textures) {
+    for (const Texture& tex : scene.textures) {
+      TextureData t;
+      try {
+        t = loadTexture(tex.path);
+      } catch (const Error& e) {
+        warnings.push_back(std::string(e.what()) + "; using a grey texel");
+        t.width = t.height = 1;
+        t.texels = {0.5f, 0.5f, 0.5f, 1.f};
+      }
+      info.insert(info.end(), {uint32_t(allTexels.size() / 4), uint32_t(t.width), uint32_t(t.height), 0u});
+      allTexels.insert(allTexels.end(), t.texels.begin(), t.texels.end());
+    }
+  }
+  texels = upload(dc, allTexels, "textures");
+  textureInfo = upload(dc, info, "texture table");
+}
+
+}  // namespace fh

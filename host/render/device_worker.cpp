@@ -1,0 +1,42 @@
+// The device worker's loop.
+#include "render/device_worker.h"
+
+#include <string>
+
+namespace fh {
+
+// Iterations queued between reads of the device's books: enough that the device is never
+// idle waiting for the host, few enough that finished passes leave soon.
+constexpr int kIterationsPerBatch = 8;
+
+void DeviceWorker::run() {
+  takePasses();
+  while (returned_ < granted_) {
+    for (int i = 0; i < kIterationsPerBatch; ++i) pipeline_.enqueueIteration();
+    pipeline_.readCounters();
+    returnCompletePasses();
+    takePasses();
+  }
+}
+
+// New passes while fewer than passSlots() are unfinished (and this device has room for them).
+void DeviceWorker::takePasses() {
+  uint32_t pass;
+  while (granted_ - returned_ < pipeline_.passSlots() && granted_ < pipeline_.passCapacity() &&
+         source_.take(index_, pass))
+    pipeline_.grantPass(granted_++, pass);
+}
+
+// Every complete pass, in local order (a pass's slot is reused only after it is returned).
+void DeviceWorker::returnCompletePasses() {
+  while (returned_ < granted_ && pipeline_.passComplete(returned_)) {
+    const uint32_t pass = pipeline_.globalPass(returned_);
+    pipeline_.takePass(returned_, samples_);
+    if (failAfter_ >= 0 && long(returned_) >= failAfter_)
+      throw Error("simulated failure (FREDHOLM_FAIL_DEVICE) on finishing pass " + std::to_string(pass));
+    ++returned_;
+    source_.done(index_, pass, samples_);
+  }
+}
+
+}  // namespace fh

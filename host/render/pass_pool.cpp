@@ -1,0 +1,133 @@
+// Handing out passes, and merging them in order.
+#include "render/pass_pool.h"
+
+#include <algorithm>
+
+namespace fh {
+namespace {
+double secondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+}  // namespace
+
+PassPool::PassPool(const RenderSettings& s, int workers)
+    : settings_(s),
+      total_(uint32_t(std::max(1, s.spp))),
+      start_(std::chrono::steady_clock::now()),
+      outstanding_(size_t(workers)),
+      done_(size_t(workers), 0),
+      film_(s.width, s.height),
+      progress_(s.progress),
+      merger_([this] { mergeInOrder(); }) {}
+
+PassPool::~PassPool() { stopMerging(); }
+
+void PassPool::stopMerging() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  changed_.notify_all();
+  if (merger_.joinable()) merger_.join();
+}
+
+bool PassPool::outOfTime() const { return settings_.seconds > 0.0 && secondsSince(start_) >= settings_.seconds; }
+
+// The next pass for `worker`. With a time budget, no new pass starts once it is spent;
+// those started finish, so every pixel ends with the same sample count. When none is left
+// but other workers still have passes in flight, a worker with none of its own waits: if
+// one of them fails, its passes come back here and must find a worker still running. (A
+// worker with passes of its own never waits; it asks again after its next batch.)
+bool PassPool::take(int worker, uint32_t& pass) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    if (!requeued_.empty()) {
+      pass = requeued_.front();
+      requeued_.pop_front();
+      break;
+    }
+    if (next_ < total_ && !outOfTime()) {
+      pass = next_++;
+      break;
+    }
+    if (!outstanding_[size_t(worker)].empty() || !anyOutstanding()) return false;
+    changed_.wait(lock);
+  }
+  outstanding_[size_t(worker)].insert(pass);
+  return true;
+}
+
+// Hands the samples over (the worker gets a spare buffer back) and returns at once.
+void PassPool::done(int worker, uint32_t pass, std::vector<float>& samples) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  outstanding_[size_t(worker)].erase(pass);
+  ++done_[size_t(worker)];
+  pending_[pass].swap(samples);
+  if (!spare_.empty()) {
+    samples.swap(spare_.back());
+    spare_.pop_back();
+  }
+  changed_.notify_all();
+}
+
+void PassPool::fail(int worker) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (uint32_t pass : outstanding_[size_t(worker)]) requeued_.push_back(pass);
+  outstanding_[size_t(worker)].clear();
+  changed_.notify_all();
+}
+
+uint64_t PassPool::passesDone(int worker) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return done_[size_t(worker)];
+}
+
+Film PassPool::finish(bool& complete) {
+  stopMerging();
+  std::lock_guard<std::mutex> lock(mutex_);
+  complete = pending_.empty() && requeued_.empty();
+  for (auto& [pass, samples] : pending_) {
+    film_.addPass(samples);
+    ++merged_;
+  }
+  pending_.clear();
+  progress_.finish(merged_ * film_.pixels(), secondsSince(start_));
+  return film_;
+}
+
+bool PassPool::anyOutstanding() const {
+  for (const auto& o : outstanding_)
+    if (!o.empty()) return true;
+  return false;
+}
+
+// The merger thread: passes join the film in pass order, so the image for a seed is the
+// same bits whichever devices rendered which passes, and in whatever order they finished.
+// A pass is added outside the lock: workers hand over passes meanwhile.
+void PassPool::mergeInOrder() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    changed_.wait(lock, [&] { return stopping_ || pending_.count(nextToMerge_) > 0; });
+    const auto next = pending_.find(nextToMerge_);
+    if (next == pending_.end()) return;  // stopping, and the next pass is not in
+    std::vector<float> samples;
+    samples.swap(next->second);
+    pending_.erase(next);
+    lock.unlock();
+    film_.addPass(samples);
+    lock.lock();
+    spare_.push_back(std::move(samples));
+    ++nextToMerge_;
+    ++merged_;
+    showProgress();
+  }
+}
+
+void PassPool::showProgress() {
+  const double elapsed = secondsSince(start_);
+  const bool timed = settings_.seconds > 0.0;
+  progress_.update(merged_ * film_.pixels(), timed ? 0 : uint64_t(total_) * film_.pixels(), elapsed,
+                   timed ? std::min(1.0, elapsed / settings_.seconds) : 0.0);
+}
+
+}  // namespace fh

@@ -1,0 +1,62 @@
+// The passes of one render in one process: handed out to device workers until the sample
+// count or the time budget is reached, merged into the film in pass order by a thread of
+// its own (a worker hands a pass over and goes back to feeding its device), with one
+// progress display. One device is a pool with one worker.
+#pragma once
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <set>
+#include <thread>
+#include <vector>
+
+#include "render/film.h"
+#include "render/pass_source.h"
+#include "render/progress.h"
+#include "render/settings.h"
+
+namespace fh {
+
+class PassPool : public PassSource {
+ public:
+  PassPool(const RenderSettings& s, int workers);
+  ~PassPool() override;
+
+  bool take(int worker, uint32_t& pass) override;
+  void done(int worker, uint32_t pass, std::vector<float>& samples) override;
+  void fail(int worker) override;
+
+  uint64_t passesDone(int worker) const;
+  // Ends the render: merges whatever finished out of order (passes lost with every device
+  // leave gaps), closes the progress display, and returns the film. `complete` is false
+  // when some pass was never rendered.
+  Film finish(bool& complete);
+
+ private:
+  bool anyOutstanding() const;
+  bool outOfTime() const;
+  void mergeInOrder();
+  void stopMerging();
+  void showProgress();
+
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;  // passes finished, or came back from a failed worker
+  const RenderSettings settings_;
+  const uint32_t total_;
+  const std::chrono::steady_clock::time_point start_;
+  uint32_t next_ = 0, nextToMerge_ = 0;
+  uint64_t merged_ = 0;
+  std::deque<uint32_t> requeued_;
+  std::vector<std::set<uint32_t>> outstanding_;
+  std::vector<uint64_t> done_;
+  std::map<uint32_t, std::vector<float>> pending_;  // finished, not yet merged
+  std::vector<std::vector<float>> spare_;           // merged passes' buffers, for reuse
+  Film film_;                                       // the merger's alone until finish()
+  Progress progress_;
+  bool stopping_ = false;
+  std::thread merger_;
+};
+
+}  // namespace fh

@@ -1,0 +1,14 @@
+// The pixel filter of the measurement equation, importance-sampled: generate offsets a
+// sample from its pixel's centre through the filter's inverse CDF, so every sample has
+// weight one and a pixel's estimate is the plain mean of its samples.
+#pragma once
+#include <vector>
+
+#include "render/settings.h"
+
+namespace fh {
+
+// The filter's 1D inverse CDF over [-radius, radius], `size` entries (separable filters).
+std::vector<float> filterInverseCdf(PixelFilter filter, int size, float* radius);
+
+}  // namespace fh

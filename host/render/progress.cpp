@@ -1,0 +1,40 @@
+// The progress display.
+#include "render/progress.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <string>
+
+namespace fh {
+
+Progress::Progress(bool enabled) : enabled_(enabled), terminal_(isatty(STDERR_FILENO) != 0) {}
+
+void Progress::update(uint64_t samples, uint64_t total, double seconds, double fraction) {
+  if (!enabled_) return;
+  if (total > 0) fraction = double(samples) / double(total);
+  const double rate = seconds > 0.0 ? double(samples) / seconds * 1e-6 : 0.0;
+  const double remaining = fraction > 0.0 ? seconds * (1.0 - fraction) / fraction : 0.0;
+  if (terminal_) {
+    const int width = 30, filled = int(fraction * width + 0.5);
+    std::fprintf(stderr, "\r[%s%s] %5.1f%%  %llu samples  %.1fs elapsed  %.1fs left  %.2f Msamples/s ",
+                 std::string(size_t(filled), '#').c_str(), std::string(size_t(width - filled), '.').c_str(),
+                 100.0 * fraction, static_cast<unsigned long long>(samples), seconds, remaining, rate);
+    std::fflush(stderr);
+    return;
+  }
+  const int decile = int(fraction * 10.0);
+  if (decile == lastDecile_) return;
+  lastDecile_ = decile;
+  std::fprintf(stderr, "fredholm: %3d%%  %llu samples  %.1fs elapsed  %.1fs left  %.2f Msamples/s\n", decile * 10,
+               static_cast<unsigned long long>(samples), seconds, remaining, rate);
+}
+
+void Progress::finish(uint64_t samples, double seconds) {
+  if (!enabled_) return;
+  if (terminal_) std::fputc('\n', stderr);
+  std::fprintf(stderr, "fredholm: %llu samples in %.2fs (%.2f Msamples/s)\n", static_cast<unsigned long long>(samples),
+               seconds, seconds > 0.0 ? double(samples) / seconds * 1e-6 : 0.0);
+}
+
+}  // namespace fh

@@ -1,0 +1,156 @@
+// A render: workers on their threads, one pool, one film.
+#include "render/render.h"
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <cstdlib>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "render/device_worker.h"
+#include "render/pass_pool.h"
+
+namespace fh {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// FREDHOLM_FAIL_DEVICE=i:n: device i fails when it finishes its (n+1)-th pass.
+long simulatedFailure(int device) {
+  const char* spec = std::getenv("FREDHOLM_FAIL_DEVICE");
+  if (!spec || !*spec) return -1;
+  const std::string s(spec);
+  const auto colon = s.find(':');
+  if (colon == std::string::npos || std::stoi(s.substr(0, colon)) != device) return -1;
+  return std::stol(s.substr(colon + 1));
+}
+
+// Every device builds its program and uploads the scene first; passes are handed out
+// once all are ready (or failed), so a device that compiles slowly is not left without
+// work by one that compiled fast.
+class StartLine {
+ public:
+  explicit StartLine(size_t devices) : devices_(devices) {}
+  void arrive() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    ++arrived_;
+    changed_.notify_all();
+    changed_.wait(lock, [&] { return arrived_ == devices_; });
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  size_t devices_, arrived_ = 0;
+};
+
+// A device to render on: one set up already, or one to set up on the worker's thread (so
+// a device that fails to start fails alone).
+struct Device {
+  DeviceInfo info;
+  DeviceContext* context = nullptr;
+};
+
+// One render in progress: the pool, and what each device's worker reports.
+class Render {
+ public:
+  Render(const std::vector<Device>& devices, const Scene& scene, const Bvh& bvh, const Camera& camera,
+         const RenderSettings& settings)
+      : devices_(devices), scene_(scene), bvh_(bvh), camera_(camera), settings_(settings),
+        pool_(settings, int(devices.size())), startLine_(devices.size()), shares_(devices.size()),
+        counts_(devices.size()), ends_(devices.size()), errors_(devices.size()) {}
+
+  RenderResult run() {
+    const auto start = Clock::now();
+    std::vector<std::thread> threads;
+    for (size_t i = 0; i < devices_.size(); ++i) threads.emplace_back([this, i] { work(i); });
+    for (auto& t : threads) t.join();
+    return collect(std::chrono::duration<double>(Clock::now() - start).count());
+  }
+
+ private:
+  // Device i's worker, on its own thread. A device that fails gives its passes back.
+  void work(size_t i) {
+    auto& share = shares_[i];
+    share.name = devices_[i].info.name;
+    bool started = false;
+    auto begin = Clock::now();
+    try {
+      std::unique_ptr<DeviceContext> own;
+      DeviceContext& dc =
+          devices_[i].context ? *devices_[i].context : *(own = std::make_unique<DeviceContext>(devices_[i].info));
+      RenderSettings perDevice = settings_;
+      perDevice.progress = false;  // the pool shows the render's progress
+      WavefrontPipeline pipeline(dc, scene_, bvh_, camera_, perDevice);
+      share.wavefront = pipeline.wavefront();
+      started = true;
+      startLine_.arrive();
+      begin = Clock::now();
+      DeviceWorker(int(i), pipeline, pool_, simulatedFailure(int(i))).run();
+      FH_CL(dc.queue.finish());
+      counts_[i] = pipeline.stats();
+    } catch (const std::exception& e) {
+      share.error = e.what();
+      errors_[i] = std::current_exception();
+      pool_.fail(int(i));
+      if (!started) startLine_.arrive();
+    }
+    ends_[i] = Clock::now();
+    share.busySeconds = std::chrono::duration<double>(ends_[i] - begin).count();
+  }
+
+  // The film and the totals. Nothing rendered and nothing left to render on: the render
+  // failed, for the reason the first device gave (a build error, a buffer too large, ...).
+  RenderResult collect(double seconds) {
+    uint64_t passes = 0;
+    for (size_t i = 0; i < devices_.size(); ++i) passes += pool_.passesDone(int(i));
+    if (passes == 0 && std::all_of(errors_.begin(), errors_.end(), [](const auto& e) { return e != nullptr; }))
+      std::rethrow_exception(errors_.front());
+    RenderResult result;
+    result.film = pool_.finish(result.complete);
+    RenderStats& st = result.stats;
+    st.seconds = seconds;
+    st.devices = shares_;
+    const auto lastEnd = *std::max_element(ends_.begin(), ends_.end());
+    for (size_t i = 0; i < devices_.size(); ++i) {
+      auto& share = st.devices[i];
+      share.samples = pool_.passesDone(int(i)) * result.film.pixels();
+      share.idleSeconds = std::chrono::duration<double>(lastEnd - ends_[i]).count();  // waiting for the last
+      st.samples += share.samples;
+      st.add(counts_[i]);
+    }
+    return result;
+  }
+
+  const std::vector<Device>& devices_;
+  const Scene& scene_;
+  const Bvh& bvh_;
+  const Camera& camera_;
+  const RenderSettings& settings_;
+  PassPool pool_;
+  StartLine startLine_;
+  std::vector<RenderStats::DeviceShare> shares_;
+  std::vector<RenderStats> counts_;
+  std::vector<Clock::time_point> ends_;
+  std::vector<std::exception_ptr> errors_;
+};
+
+}  // namespace
+
+RenderResult render(const std::vector<DeviceInfo>& devices, const Scene& scene, const Bvh& bvh, const Camera& camera,
+                    const RenderSettings& settings) {
+  std::vector<Device> list;
+  for (const auto& d : devices) list.push_back({d, nullptr});
+  return Render(list, scene, bvh, camera, settings).run();
+}
+
+RenderResult render(DeviceContext& device, const Scene& scene, const Bvh& bvh, const Camera& camera,
+                    const RenderSettings& settings) {
+  const std::vector<Device> list = {{device.info, &device}};
+  return Render(list, scene, bvh, camera, settings).run();
+}
+
+}  // namespace fh

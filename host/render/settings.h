@@ -1,0 +1,32 @@
+// What a render is asked to do: size, budget, method, filter and the knobs the path
+// tracer exposes. Parsed and checked by the command line (host/cli), used by every layer
+// of a render.
+#pragma once
+#include <array>
+#include <cstddef>
+#include <string>
+
+namespace fh {
+
+enum class Method { PT, NEE, MIS };
+const char* methodName(Method m);
+
+enum class PixelFilter { Box, Gaussian, BlackmanHarris };
+const char* filterName(PixelFilter f);
+
+struct RenderSettings {
+  int width = 512, height = 512;
+  int spp = 64;          // samples per pixel; with seconds > 0, the most to take
+  double seconds = 0.0;  // time budget: stop at the end of the pass running when it is spent
+  Method method = Method::MIS;
+  int maxDepth = 64;     // bounces; Russian roulette does the real work
+  int rrDepth = 3;       // Russian roulette from this bounce on
+  unsigned seed = 1;
+  std::array<float, 3> env{0.f, 0.f, 0.f};
+  PixelFilter filter = PixelFilter::Box;
+  size_t wavefront = 0;  // paths in flight per device; 0: chosen for each device
+  bool progress = false;
+  bool allFeatures = false;  // compile every material feature, not only the scene's (benchmarks)
+};
+
+}  // namespace fh

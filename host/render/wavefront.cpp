@@ -1,0 +1,225 @@
+// The pipeline on one device: buffers and kernels set up once, then iterations that are
+// nothing but the stages in order.
+#include "render/wavefront.h"
+
+#include <algorithm>
+#include <cstddef>
+
+#include "render/pixel_filter.h"
+
+namespace fh {
+namespace {
+
+constexpr int kFilterTableSize = 256;
+
+// Sets a kernel's arguments in the order they are given, so no call site counts indices.
+class ArgumentList {
+ public:
+  explicit ArgumentList(cl::Kernel& kernel) : kernel_(kernel) {}
+  template <typename T>
+  ArgumentList& operator<<(const T& value) {
+    FH_CL(kernel_.setArg(next_++, value));
+    return *this;
+  }
+  // Every path-state field, in FH_PATH_FIELDS order: a stage's FH_PATH_PARAMS.
+  ArgumentList& operator<<(const PathStateBuffers& p) {
+#define FH_ARGUMENT(type, name, bytes) *this << p.name;
+    FH_PATH_FIELDS(FH_ARGUMENT)
+#undef FH_ARGUMENT
+    return *this;
+  }
+  // Every light-sample request field: FH_SHADOW_PARAMS.
+  ArgumentList& operator<<(const ShadowRequestBuffers& r) {
+#define FH_ARGUMENT(type, name, bytes) *this << r.name;
+    FH_SHADOW_FIELDS(FH_ARGUMENT)
+#undef FH_ARGUMENT
+    return *this;
+  }
+
+ private:
+  cl::Kernel& kernel_;
+  cl_uint next_ = 0;
+};
+
+gpu::RenderParams renderParams(const RenderSettings& s, const Camera& camera, unsigned lightCount,
+                               std::vector<float>& filterTable) {
+  gpu::RenderParams p{};
+  p.camera = makeCameraParams(camera, s.width, s.height);
+  for (size_t c = 0; c < 3; ++c) p.env[c] = s.env[c];
+  p.seed = s.seed;
+  p.pixel_count = unsigned(s.width) * unsigned(s.height);
+  p.max_depth = unsigned(s.maxDepth);
+  p.rr_depth = unsigned(s.rrDepth);
+  p.light_count = lightCount;
+  filterTable = filterInverseCdf(s.filter, kFilterTableSize, &p.filter_radius);
+  p.filter_table_size = unsigned(filterTable.size());
+  return p;
+}
+
+}  // namespace
+
+ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsigned passSlots,
+                              const std::string& traversalOptions) {
+  const char* methodFlag = method == Method::PT ? "PT" : method == Method::NEE ? "NEE" : "MIS";
+  return {std::string("path tracer (") + methodName(method) + features.buildOptions() + ")", stageFiles(),
+          traversalOptions + features.buildOptions() + " -DFH_PASS_SLOTS=" + std::to_string(passSlots) +
+              " -DFH_METHOD_" + methodFlag};
+}
+
+size_t defaultWavefront(const DeviceInfo& device, size_t pixels) {
+  // GPU: the best of the H200 sweep in bench/RESULTS.md (issue 12); larger wavefronts ran emptier.
+  const size_t preferred = device.type == "gpu" ? (size_t(1) << 19) : (size_t(1) << 16);
+  return std::max<size_t>(kLocalSize, std::min(preferred, 2 * pixels));
+}
+
+WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const Camera& camera,
+                                     const RenderSettings& s)
+    : dc_(dc),
+      method_(s.method),
+      scene_(dc, scene, bvh, s.allFeatures ? SceneFeatures::all() : sceneFeatures(scene)),
+      pixels_(unsigned(s.width) * unsigned(s.height)) {
+  wavefront_ = s.wavefront ? s.wavefront : defaultWavefront(dc.info, pixels_);
+  std::vector<float> filterTable;
+  params_ = renderParams(s, camera, scene_.lightCount, filterTable);
+  // Enough passes in flight that the wavefront stays full while a pass's longest paths
+  // finish: pass buffers cost a frame each, so only as many as the wavefront needs.
+  passSlots_ = unsigned(std::min<size_t>(FH_MAX_PASS_SLOTS, 2 + (2 * wavefront_ + pixels_ - 1) / pixels_));
+  // Every pass this device may render: at most spp of them (a time budget stops earlier).
+  const uint64_t maxPasses = uint64_t(std::max(1, s.spp));
+  if (maxPasses * pixels_ >= (uint64_t(1) << 32))
+    throw Error("--spp " + std::to_string(s.spp) + " at " + std::to_string(s.width) + "x" + std::to_string(s.height) +
+                " is more than 2^32 samples in one render; render fewer");
+  passTable_.assign(maxPasses, 0);
+
+  const cl::Program program = buildProgram(
+      dc.context, dc.info.device, pathTracerProgram(scene_.features, s.method, passSlots_, scene_.bvh.traversalOptions()));
+  for (auto& kernels : kernels_)
+    for (size_t i = 0; i < kStages.size(); ++i) kernels[i] = createKernel(program, kStages[i].kernel);
+  allocateBuffers(filterTable);
+  bindArguments(0);
+  bindArguments(1);
+}
+
+void WavefrontPipeline::allocateBuffers(const std::vector<float>& filterTable) {
+  auto buffer = [&](size_t bytes, const char* what, const void* host = nullptr) {
+    return allocateBuffer(dc_.context, dc_.info.device, CL_MEM_READ_WRITE, bytes, what, host);
+  };
+#define FH_ALLOCATE(type, name, bytes) paths_.name = buffer(wavefront_ * (bytes), "path state " #name);
+  FH_PATH_FIELDS(FH_ALLOCATE)
+#undef FH_ALLOCATE
+#define FH_ALLOCATE(type, name, bytes) shadowRequests_.name = buffer(wavefront_ * (bytes), #name);
+  FH_SHADOW_FIELDS(FH_ALLOCATE)
+#undef FH_ALLOCATE
+  for (auto& q : queues_.rays) q = buffer(wavefront_ * 4, "ray queue");
+  queues_.finished = buffer(wavefront_ * 4, "finished queue");
+  std::vector<unsigned> allFree(wavefront_);
+  for (size_t i = 0; i < wavefront_; ++i) allFree[i] = unsigned(i);
+  queues_.freeSlots = buffer(wavefront_ * 4, "free list", allFree.data());
+  counters_.free_length = unsigned(wavefront_);
+  queues_.counters = buffer(sizeof counters_, "queue counters", &counters_);
+  passBuffers_ = buffer(size_t(passSlots_) * pixels_ * 16, "pass buffers");
+  FH_CL(dc_.queue.enqueueFillBuffer(passBuffers_, 0u, 0, size_t(passSlots_) * pixels_ * 16));
+  filterTable_ = allocateBuffer(dc_.context, dc_.info.device, CL_MEM_READ_ONLY, filterTable.size() * 4,
+                                "filter table", filterTable.data());
+  passTableBuffer_ = buffer(passTable_.size() * 4, "pass table");
+}
+
+// Every argument of every stage, for one parity. The argument lists follow the kernels'
+// parameter lists in kernels/<stage>.cl.
+void WavefrontPipeline::bindArguments(unsigned parity) {
+  auto& k = kernels_[parity];
+  auto args = [&](Stage s) { return ArgumentList(k[size_t(s)]); };
+  const cl::Buffer& rays = queues_.rays[parity];
+  const cl::Buffer& nextRays = queues_.rays[1 - parity];
+  const DeviceScene& sc = scene_;
+
+  args(Stage::PlanIteration) << queues_.counters << parity;
+  args(Stage::Generate) << params_ << queues_.counters << queues_.freeSlots << rays << filterTable_
+                        << passTableBuffer_ << paths_;
+  args(Stage::Intersect) << sc.bvh.nodes() << sc.bvh.blocks() << rays << queues_.counters << parity
+                         << paths_.ray_org << paths_.ray_dir << paths_.hit;
+  args(Stage::Shade) << params_ << rays << nextRays << queues_.finished << queues_.counters << parity
+                     << sc.bvh.triangles() << sc.triangleMaterial << sc.materials << sc.lightPdfArea << sc.normals
+                     << sc.uvs << sc.texels << sc.textureInfo << paths_ << shadowRequests_;
+  args(Stage::ShadowConnect) << params_ << queues_.counters << sc.bvh.nodes() << sc.bvh.blocks()
+                             << sc.bvh.triangles() << sc.triangleMaterial << sc.materials << sc.lightCdf
+                             << sc.lightTriangle << sc.lightPdfArea << paths_ << shadowRequests_;
+  args(Stage::Accumulate) << queues_.finished << queues_.counters << queues_.freeSlots << pixels_ << passBuffers_
+                          << paths_;
+  args(Stage::FinishIteration) << queues_.counters << parity;
+}
+
+// Each stage is launched over the whole wavefront and reads its queue's length on the
+// device, so nothing here waits for the device.
+void WavefrontPipeline::enqueueIteration() {
+  planIteration();
+  generate();
+  intersect();
+  shade();
+  if (method_ != Method::PT && scene_.lightCount > 0) shadowConnect();
+  accumulate();
+  finishIteration();
+  parity_ = 1 - parity_;
+}
+
+void WavefrontPipeline::run(Stage stage, size_t items) {
+  cl::Event event;
+  launch(dc_, kernels_[parity_][size_t(stage)], items, stageInfo(stage).kernel, &event);
+  events_.emplace_back(stage, event);
+}
+
+void WavefrontPipeline::writeCounter(size_t offset, const uint32_t& value) {
+  FH_CL(dc_.queue.enqueueWriteBuffer(queues_.counters, CL_FALSE, offset, 4, &value));
+}
+
+void WavefrontPipeline::grantPass(uint64_t local, uint32_t global) {
+  passTable_[local] = global;
+  FH_CL(dc_.queue.enqueueWriteBuffer(passTableBuffer_, CL_FALSE, local * 4, 4, &passTable_[local]));
+  // The pass may start once the limit covers it. Stable storage: the write is asynchronous.
+  sampleLimit_ = uint32_t((local + 1) * pixels_);
+  writeCounter(offsetof(gpu::WavefrontCounters, sample_limit), sampleLimit_);
+}
+
+const gpu::WavefrontCounters& WavefrontPipeline::readCounters() {
+  FH_CL(dc_.queue.enqueueReadBuffer(queues_.counters, CL_TRUE, 0, sizeof counters_, &counters_));
+  for (const auto& [stage, event] : events_) {
+    cl_ulong start = 0, end = 0;
+    FH_CL(event.getProfilingInfo(CL_PROFILING_COMMAND_START, &start));
+    FH_CL(event.getProfilingInfo(CL_PROFILING_COMMAND_END, &end));
+    stageSeconds_[stageInfo(stage).kernel] += double(end - start) * 1e-9;
+  }
+  events_.clear();
+  return counters_;
+}
+
+bool WavefrontPipeline::passComplete(uint64_t local) const {
+  return counters_.pass_done[local % passSlots_] == pixels_;
+}
+
+void WavefrontPipeline::takePass(uint64_t local, std::vector<float>& samples) {
+  const size_t slot = size_t(local % passSlots_), bytes = size_t(pixels_) * 16;
+  samples.resize(size_t(pixels_) * 4);
+  FH_CL(dc_.queue.enqueueReadBuffer(passBuffers_, CL_TRUE, slot * bytes, bytes, samples.data()));
+  FH_CL(dc_.queue.enqueueFillBuffer(passBuffers_, 0u, slot * bytes, bytes));
+  // Safe to reset: the next pass using this slot has not been granted yet.
+  static const uint32_t zero = 0;
+  writeCounter(offsetof(gpu::WavefrontCounters, pass_done) + slot * 4, zero);
+  counters_.pass_done[slot] = 0;
+}
+
+RenderStats WavefrontPipeline::stats() {
+  auto total64 = [](const uint32_t* pair) { return uint64_t(pair[0]) | uint64_t(pair[1]) << 32; };
+  RenderStats st;
+  st.cameraRays = counters_.next_sample;
+  st.bounceRays = total64(counters_.bounce_rays);
+  st.shadowRays = total64(counters_.shadow_rays);
+  st.iterations = counters_.iterations;
+  st.nonfinite = counters_.nonfinite;
+  st.wavefront = wavefront_;
+  st.queuedRays = total64(counters_.queued_rays);
+  st.slotIterations = st.iterations * wavefront_;
+  st.stageSeconds = stageSeconds_;
+  return st;
+}
+
+}  // namespace fh

@@ -1,0 +1,113 @@
+// The wavefront path tracer on one device: the stages of host/render/stages.h over queues
+// of path slots, with the path state in structure-of-arrays buffers declared once in
+// kernels/path_state.h. It renders the passes it is granted, each into a pass buffer,
+// and hands back a pass once all its pixels are in; the device keeps its own books
+// (kernels/iteration.cl), so iterations are queued without waiting for the device.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "kernels/path_state.h"
+#include "render/device_scene.h"
+#include "render/render_stats.h"
+#include "render/settings.h"
+#include "render/stages.h"
+#include "scene/camera.h"
+
+namespace fh {
+
+// The path state, one buffer per field of FH_PATH_FIELDS, by the field's name.
+struct PathStateBuffers {
+#define FH_BUFFER(type, name, bytes) cl::Buffer name;
+  FH_PATH_FIELDS(FH_BUFFER)
+#undef FH_BUFFER
+};
+
+// shade's light-sample requests for shadow_connect, one buffer per field of FH_SHADOW_FIELDS.
+struct ShadowRequestBuffers {
+#define FH_BUFFER(type, name, bytes) cl::Buffer name;
+  FH_SHADOW_FIELDS(FH_BUFFER)
+#undef FH_BUFFER
+};
+
+// The queues of path slots (kernels/queues.h): two ray queues (an iteration reads one and
+// fills the other), the paths finished this iteration and the free slots. Their lengths
+// are fields of `counters`, a gpu::WavefrontCounters.
+struct SlotQueues {
+  std::array<cl::Buffer, 2> rays;
+  cl::Buffer finished, freeSlots, counters;
+};
+
+// The path tracer's program for a scene's features, a method and the passes in flight.
+ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsigned passSlots,
+                              const std::string& traversalOptions);
+
+// The default number of paths in flight: 512k on a GPU, fewer on a CPU, where the
+// path state should stay near the caches; never more than two passes of pixels.
+size_t defaultWavefront(const DeviceInfo& device, size_t pixels);
+
+class WavefrontPipeline {
+ public:
+  WavefrontPipeline(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const Camera& camera,
+                    const RenderSettings& s);
+
+  // One iteration over every path in flight; returns at once (the device runs it later).
+  void enqueueIteration();
+
+  // Passes are numbered locally (0, 1, ... on this device) and mapped to global passes,
+  // which seed the samples. At most passSlots() granted passes may be unfinished.
+  unsigned passSlots() const { return passSlots_; }
+  uint64_t passCapacity() const { return passTable_.size(); }
+  void grantPass(uint64_t local, uint32_t global);
+  uint32_t globalPass(uint64_t local) const { return passTable_[local]; }
+
+  // Waits for the queued iterations and reads the books back.
+  const gpu::WavefrontCounters& readCounters();
+  // Whether local pass `local` is complete, as of the last readCounters().
+  bool passComplete(uint64_t local) const;
+  // Reads a complete pass's samples (rgb, 1 per pixel) and frees its slot for a new pass.
+  void takePass(uint64_t local, std::vector<float>& samples);
+
+  // This device's counts so far (samples are the film's to count) and stage times.
+  RenderStats stats();
+  size_t wavefront() const { return wavefront_; }
+
+ private:
+  // The stages; each launches its kernel, bound for the current parity.
+  void planIteration() { run(Stage::PlanIteration, 1); }
+  void generate() { run(Stage::Generate, wavefront_); }
+  void intersect() { run(Stage::Intersect, wavefront_); }
+  void shade() { run(Stage::Shade, wavefront_); }
+  void shadowConnect() { run(Stage::ShadowConnect, wavefront_); }
+  void accumulate() { run(Stage::Accumulate, wavefront_); }
+  void finishIteration() { run(Stage::FinishIteration, 1); }
+  void run(Stage stage, size_t items);
+
+  void allocateBuffers(const std::vector<float>& filterTable);
+  void bindArguments(unsigned parity);
+  void writeCounter(size_t offset, const uint32_t& value);
+
+  DeviceContext& dc_;
+  Method method_;
+  DeviceScene scene_;
+  gpu::RenderParams params_{};
+  size_t wavefront_;
+  unsigned pixels_, passSlots_;
+  unsigned parity_ = 0;  // which ray queue is current
+  PathStateBuffers paths_;
+  ShadowRequestBuffers shadowRequests_;
+  SlotQueues queues_;
+  cl::Buffer passBuffers_, filterTable_, passTableBuffer_;
+  std::vector<uint32_t> passTable_;  // global pass of each local pass (stable storage for writes)
+  uint32_t sampleLimit_ = 0;         // local samples that may start (stable storage for writes)
+  gpu::WavefrontCounters counters_{};
+  // Every stage's kernel twice, bound once for each parity: an iteration sets nothing.
+  std::array<std::array<cl::Kernel, kStages.size()>, 2> kernels_;
+  std::vector<std::pair<Stage, cl::Event>> events_;
+  std::map<std::string, double> stageSeconds_;
+};
+
+}  // namespace fh

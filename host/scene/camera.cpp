@@ -1,0 +1,106 @@
+// Camera sources and the camera basis.
+#include "scene/camera.h"
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "base/error.h"
+#include "base/vec.h"
+
+namespace fh {
+namespace {
+
+std::array<float, 3> readVec3(const nlohmann::json& j, const char* key, const std::string& path) {
+  if (!j.contains(key)) throw Error(path + ": camera is missing \"" + key + "\"");
+  const auto& v = j.at(key);
+  if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() || !v[2].is_number())
+    throw Error(path + ": camera \"" + key + "\" must be an array of three numbers");
+  return {v[0].get<float>(), v[1].get<float>(), v[2].get<float>()};
+}
+
+}  // namespace
+
+Camera loadCameraJson(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open camera file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parseCameraJson(text.str(), path);
+}
+
+Camera parseCameraJson(const std::string& text, const std::string& path) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw Error(path + ": invalid JSON (" + e.what() + ")");
+  }
+  if (!j.is_object()) throw Error(path + ": camera file must hold a JSON object");
+  Camera c;
+  c.eye = readVec3(j, "eye", path);
+  c.target = readVec3(j, "target", path);
+  c.up = j.contains("up") ? readVec3(j, "up", path) : std::array<float, 3>{0.f, 1.f, 0.f};
+  if (!j.contains("fov_y_deg") || !j["fov_y_deg"].is_number())
+    throw Error(path + ": camera needs a number \"fov_y_deg\"");
+  c.fovYDeg = j["fov_y_deg"].get<float>();
+  validateCamera(c, path);
+  return c;
+}
+
+void validateCamera(const Camera& c, const std::string& source) {
+  if (!isFinite(c.eye) || !isFinite(c.target) || !isFinite(c.up) || !std::isfinite(c.fovYDeg))
+    throw Error(source + ": camera values must be finite");
+  if (!(c.fovYDeg > 0.f && c.fovYDeg < 180.f))
+    throw Error(source + ": vertical field of view must lie in (0, 180) degrees");
+  const float3 forward = c.target - c.eye;
+  if (length(forward) == 0.f) throw Error(source + ": camera eye and target coincide");
+  if (length(cross(normalize(forward), c.up)) < 1e-6f)
+    throw Error(source + ": camera up vector is parallel to the view direction");
+}
+
+Camera frameBounds(const std::array<float, 3>& lo, const std::array<float, 3>& hi, float fovYDeg) {
+  const float3 center = (lo + hi) * 0.5f;
+  const float radius = std::fmax(0.5f * length(hi - lo), 1e-6f);
+  const float distance = radius / std::sin(0.5f * fovYDeg * float(M_PI) / 180.f);
+  Camera c;
+  c.target = center;
+  c.eye = center + float3{0.f, 0.f, distance};
+  c.up = {0.f, 1.f, 0.f};
+  c.fovYDeg = fovYDeg;
+  return c;
+}
+
+CameraFrame makeCameraFrame(const Camera& c, int width, int height) {
+  CameraFrame f;
+  f.origin = c.eye;
+  f.forward = normalize(c.target - c.eye);
+  f.right = normalize(cross(f.forward, c.up));
+  f.up = cross(f.right, f.forward);
+  f.tanHalfFovY = std::tan(0.5f * c.fovYDeg * float(M_PI) / 180.f);
+  f.aspect = float(width) / float(height);
+  return f;
+}
+
+std::array<float, 3> cameraRayDirection(const CameraFrame& f, float px, float py, int width, int height) {
+  const float sx = (2.f * px / float(width) - 1.f) * f.tanHalfFovY * f.aspect;
+  const float sy = (1.f - 2.f * py / float(height)) * f.tanHalfFovY;
+  return f.forward + f.right * sx + f.up * sy;
+}
+
+gpu::CameraParams makeCameraParams(const Camera& camera, int width, int height) {
+  const CameraFrame f = makeCameraFrame(camera, width, height);
+  gpu::CameraParams p{};
+  for (int k = 0; k < 3; ++k) {
+    p.origin[k] = f.origin[size_t(k)];
+    p.forward[k] = f.forward[size_t(k)];
+    p.right[k] = f.right[size_t(k)] * f.tanHalfFovY * f.aspect;
+    p.up[k] = f.up[size_t(k)] * f.tanHalfFovY;
+  }
+  p.width = width;
+  p.height = height;
+  return p;
+}
+
+}  // namespace fh

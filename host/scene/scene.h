@@ -1,0 +1,65 @@
+// A scene as flat, device-ready arrays: what the loader produces and the BVH, the
+// kernels and the tests consume.
+#pragma once
+#include <array>
+#include <string>
+#include <vector>
+
+#include "scene/camera.h"
+
+namespace fh {
+
+using Vec3f = std::array<float, 3>;
+
+// The MTL fields later stages use. Tf only means transmission for the glass illum
+// models (4, 6, 7, 9): `isGlass()` says when.
+struct Material {
+  std::string name;
+  Vec3f kd{0.5f, 0.5f, 0.5f};
+  Vec3f ks{0.f, 0.f, 0.f};
+  Vec3f ke{0.f, 0.f, 0.f};  // emitted radiance, front (counter-clockwise) side only
+  Vec3f tf{1.f, 1.f, 1.f};
+  float ns = 0.f;
+  float ni = 1.f;
+  float d = 1.f;
+  int illum = 2;
+  int kdTexture = -1;  // index into Scene::textures, -1 for none
+
+  bool isEmissive() const { return ke[0] > 0.f || ke[1] > 0.f || ke[2] > 0.f; }
+  bool isGlass() const { return illum == 4 || illum == 6 || illum == 7 || illum == 9; }
+};
+
+struct Texture {
+  std::string path;  // resolved on disk (case-insensitive fallback applied)
+};
+
+// One emissive triangle, as the light sampler will see it.
+struct Light {
+  unsigned triangle = 0;
+  float area = 0.f;
+  Vec3f power{0.f, 0.f, 0.f};  // pi * area * Ke: a one-sided Lambertian emitter
+};
+
+struct Scene {
+  std::string sourcePath;
+  std::vector<float> positions;          // xyz per vertex
+  std::vector<unsigned> indices;         // three vertex indices per triangle
+  std::vector<int> triangleMaterial;     // material per triangle
+  std::vector<float> cornerNormals;      // 9 floats per triangle; empty if the file has none
+  std::vector<float> cornerUVs;          // 6 floats per triangle; empty if the file has none
+  std::vector<Material> materials;       // the last one may be the default grey
+  std::vector<Texture> textures;
+  std::vector<Light> lights;
+  std::vector<std::string> warnings;
+  bool hasCamera = false;                // a camera sidecar was found next to the OBJ
+  Camera camera;
+
+  size_t triangleCount() const { return indices.size() / 3; }
+  size_t vertexCount() const { return positions.size() / 3; }
+  Vec3f vertex(unsigned i) const { return {positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]}; }
+  // Corner k (0..2) of triangle t.
+  Vec3f corner(size_t t, int k) const { return vertex(indices[3 * t + size_t(k)]); }
+  void bounds(Vec3f& lo, Vec3f& hi) const;
+};
+
+}  // namespace fh

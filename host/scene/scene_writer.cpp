@@ -1,0 +1,90 @@
+// OBJ/MTL writer: one vertex list, faces grouped by `usemtl` in triangle order.
+#include "scene/scene_writer.h"
+
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <nlohmann/json.hpp>
+
+#include "base/error.h"
+#include "image/image_io.h"
+
+namespace fh {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::ofstream openForWriting(const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw Error(path + ": cannot open for writing");
+  out << std::setprecision(9);  // round-trips a float
+  return out;
+}
+
+void writeTriple(std::ofstream& out, const char* key, const Vec3f& v) {
+  out << key << ' ' << v[0] << ' ' << v[1] << ' ' << v[2] << '\n';
+}
+
+void writeMtl(const Scene& scene, const std::string& path) {
+  std::ofstream out = openForWriting(path);
+  out << "# written by fredholm export from " << scene.sourcePath << "\n";
+  for (const Material& m : scene.materials) {
+    out << "\nnewmtl " << m.name << '\n';
+    writeTriple(out, "Kd", m.kd);
+    writeTriple(out, "Ks", m.ks);
+    writeTriple(out, "Ke", m.ke);
+    if (m.isGlass()) writeTriple(out, "Tf", m.tf);
+    out << "Ns " << m.ns << "\nNi " << m.ni << "\nd " << m.d << "\nillum " << m.illum << '\n';
+    if (m.kdTexture >= 0) out << "map_Kd " << fs::absolute(scene.textures[size_t(m.kdTexture)].path).string() << '\n';
+  }
+}
+
+void writeObj(const Scene& scene, const std::string& path, const std::string& mtlName) {
+  std::ofstream out = openForWriting(path);
+  out << "# written by fredholm export from " << scene.sourcePath << "\nmtllib " << mtlName << '\n';
+  for (size_t v = 0; v < scene.vertexCount(); ++v) writeTriple(out, "v", scene.vertex(unsigned(v)));
+  const bool normals = !scene.cornerNormals.empty(), uvs = !scene.cornerUVs.empty();
+  for (size_t c = 0; normals && c < scene.cornerNormals.size(); c += 3)
+    out << "vn " << scene.cornerNormals[c] << ' ' << scene.cornerNormals[c + 1] << ' ' << scene.cornerNormals[c + 2]
+        << '\n';
+  for (size_t c = 0; uvs && c < scene.cornerUVs.size(); c += 2)
+    out << "vt " << scene.cornerUVs[c] << ' ' << scene.cornerUVs[c + 1] << '\n';
+  int material = -1;
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    if (scene.triangleMaterial[t] != material) {
+      material = scene.triangleMaterial[t];
+      out << "usemtl " << scene.materials[size_t(material)].name << '\n';
+    }
+    out << 'f';
+    for (size_t k = 0; k < 3; ++k) {
+      const size_t corner = 3 * t + k + 1;  // normals and UVs are stored per corner
+      out << ' ' << scene.indices[3 * t + k] + 1;
+      if (uvs || normals) out << '/' << (uvs ? std::to_string(corner) : "");
+      if (normals) out << '/' << corner;
+    }
+    out << '\n';
+  }
+}
+
+void writeCamera(const Camera& c, const std::string& path) {
+  std::ofstream out = openForWriting(path);
+  const nlohmann::json j = {{"eye", c.eye}, {"target", c.target}, {"up", c.up}, {"fov_y_deg", c.fovYDeg}};
+  out << j.dump() << '\n';
+}
+
+}  // namespace
+
+std::vector<std::string> writeObjScene(const Scene& scene, const std::string& objPath, bool force) {
+  if (fs::path(objPath).extension() != ".obj") throw Error("-o '" + objPath + "': the output must end in .obj");
+  const std::string mtl = fs::path(objPath).replace_extension(".mtl").string();
+  const std::string camera = fs::path(objPath).replace_extension(".camera.json").string();
+  std::vector<std::string> paths = {objPath, mtl};
+  if (scene.hasCamera) paths.push_back(camera);
+  for (const std::string& p : paths) checkOutputFile(p, force, "-o");
+  writeMtl(scene, mtl);
+  writeObj(scene, objPath, fs::path(mtl).filename().string());
+  if (scene.hasCamera) writeCamera(scene.camera, camera);
+  return paths;
+}
+
+}  // namespace fh

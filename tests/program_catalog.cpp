@@ -1,0 +1,22 @@
+#include "program_catalog.h"
+
+#include "bench/ray_workload.h"
+#include "kernels/path_state.h"
+#include "render/render_aov.h"
+#include "render/wavefront.h"
+
+namespace fh {
+
+std::vector<ProgramSpec> everyProgramVariant() {
+  // The deepest stack a BVH asks for changes only an array size; the default stands in.
+  const std::string traversal = "-DFH_TRAVERSAL_STACK=64";
+  std::vector<ProgramSpec> programs = {intersectProgram(traversal), benchRaysProgram(traversal), aovProgram()};
+  for (Method method : {Method::PT, Method::NEE, Method::MIS})
+    for (unsigned bits = 0; bits < 16; ++bits) {
+      const SceneFeatures features{(bits & 1) != 0, (bits & 2) != 0, (bits & 4) != 0, (bits & 8) != 0};
+      programs.push_back(pathTracerProgram(features, method, FH_MAX_PASS_SLOTS, traversal));
+    }
+  return programs;
+}
+
+}  // namespace fh
