@@ -5,10 +5,11 @@ drifts by tens of percent between runs, so only interleaved figures compare).
   bench/ab_speed.py OLD NEW [--rounds 5] -- render ARGS...
 
 Each round renders ARGS with OLD then NEW (the order swapped every other round), reads
-samples/s from --stats, and the table reports each binary's median and the ratio NEW/OLD.
+samples/s from --stats and times the whole process (start-up, scene, BVH and kernel set-up
+included, which --stats may leave out), and reports each binary's medians and NEW/OLD.
 The first render of each binary is a warm-up (kernel compilation) and is not counted.
 """
-import argparse, json, os, statistics, subprocess, sys, tempfile
+import argparse, json, os, statistics, subprocess, sys, tempfile, time
 
 
 def render(binary, args, workdir, tag):
@@ -16,10 +17,13 @@ def render(binary, args, workdir, tag):
     for path in (out, stats):
         if os.path.exists(path):
             os.remove(path)
+    start = time.monotonic()
     subprocess.run([binary] + args + ["-o", out, "--stats", stats], check=True,
                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    wall = time.monotonic() - start
     with open(stats) as f:
-        return json.load(f)["samples_per_second"]
+        doc = json.load(f)
+    return doc["samples_per_second"], doc["samples"] / wall
 
 
 def main():
@@ -33,7 +37,7 @@ def main():
     parser.add_argument("--rounds", type=int, default=5)
     opts = parser.parse_args(argv[:split])
     args = argv[split + 1:]
-    speeds = {"old": [], "new": []}
+    speeds = {"old": [], "new": []}  # (stats samples/s, samples per process second)
     binaries = {"old": opts.old, "new": opts.new}
     with tempfile.TemporaryDirectory() as workdir:
         for tag in ("old", "new"):
@@ -41,13 +45,21 @@ def main():
         for r in range(opts.rounds):
             for tag in (("old", "new") if r % 2 == 0 else ("new", "old")):
                 speeds[tag].append(render(binaries[tag], args, workdir, tag))
-    old, new = statistics.median(speeds["old"]), statistics.median(speeds["new"])
-    print("render " + " ".join(args))
+    print("fredholm " + " ".join(args))
+    medians = {}
     for tag in ("old", "new"):
-        runs = ", ".join("%.3f" % (s / 1e6) for s in speeds[tag])
-        print("  %-3s median %.3f Msamples/s  (runs: %s)" % (tag, statistics.median(speeds[tag]) / 1e6, runs))
-    print("  new/old %.3f" % (new / old))
-
+        rate = [s for s, _ in speeds[tag]]
+        whole = [w for _, w in speeds[tag]]
+        medians[tag] = (statistics.median(rate), statistics.median(whole))
+        runs = ", ".join("%.3f" % (s / 1e6) for s in rate)
+        print("  %-3s median %.3f Msamples/s rendering, %.3f per process second  (runs: %s)"
+              % (tag, medians[tag][0] / 1e6, medians[tag][1] / 1e6, runs))
+    print("  new/old %.3f rendering, %.3f per process second"
+          % (medians["new"][0] / medians["old"][0], medians["new"][1] / medians["old"][1]))
+    # The machine drifts within a run too: the two renders of one round ran close together.
+    per_round = [n[0] / o[0] for o, n in zip(speeds["old"], speeds["new"])]
+    print("  new/old per round: median %.3f  (%s)" % (statistics.median(per_round),
+                                                      ", ".join("%.2f" % r for r in per_round)))
 
 if __name__ == "__main__":
     main()

@@ -56,4 +56,11 @@ class SceneBuilder {
   Scene scene_;
 };
 
+// One slanted quad, `copies` times on top of itself: duplicated faces (as in the archive's
+// Cornell box) put equal hits in different BVH leaves, the intersect kernel's tie.
+inline void coincidentQuads(SceneBuilder& b, int copies, int material) {
+  for (int copy = 0; copy < copies; ++copy)
+    b.quad({-1.f, -0.7f, 0.3f}, {1.2f, -0.9f, -0.4f}, {0.9f, 1.1f, -0.2f}, {-1.1f, 0.8f, 0.5f}, material);
+}
+
 }  // namespace fh::test

@@ -19,6 +19,7 @@
 #include "base/vec.h"
 #include "bench/ray_workload.h"
 #include "scene/scene_loader.h"
+#include "scene_builder.h"
 #include "test_support.h"
 
 namespace fh {
@@ -381,15 +382,9 @@ TEST(Watertight, RaysAtSharedEdgesAndVerticesNeverMiss) {
 TEST(CoincidentTriangles, HitsKeepTheirOwnTriangleAndBarycentrics) {
   // A slanted quad copied twelve times (more than one leaf holds), and a grid of slanted
   // quads whose shared edges cross leaves.
-  Scene copies;
-  copies.materials.push_back(Material{});
-  const float3 quad[4] = {{-1.f, -0.7f, 0.3f}, {1.2f, -0.9f, -0.4f}, {0.9f, 1.1f, -0.2f}, {-1.1f, 0.8f, 0.5f}};
-  for (int copy = 0; copy < 12; ++copy) {
-    const unsigned base = unsigned(copies.vertexCount());
-    for (const float3& p : quad) copies.positions.insert(copies.positions.end(), p.begin(), p.end());
-    for (unsigned k : {0u, 1u, 2u, 0u, 2u, 3u}) copies.indices.push_back(base + k);
-    copies.triangleMaterial.insert(copies.triangleMaterial.end(), {0, 0});
-  }
+  test::SceneBuilder builder;
+  test::coincidentQuads(builder, 12, builder.material(0.5f));
+  Scene copies = builder.build();
   Scene grid;
   grid.materials.push_back(Material{});
   const int cells = 24;

@@ -40,6 +40,10 @@ bool PassPool::outOfTime() const { return settings_.seconds > 0.0 && secondsSinc
 // worker with passes of its own never waits; it asks again after its next batch.)
 bool PassPool::take(int worker, uint32_t& pass) {
   std::unique_lock<std::mutex> lock(mutex_);
+  if (!started_) {  // the time budget counts from the first pass handed out
+    start_ = std::chrono::steady_clock::now();
+    started_ = true;
+  }
   for (;;) {
     if (!requeued_.empty()) {
       pass = requeued_.front();

@@ -45,7 +45,8 @@ class PassPool : public PassSource {
   std::condition_variable changed_;  // passes finished, or came back from a failed worker
   const RenderSettings settings_;
   const uint32_t total_;
-  const std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point start_;  // when the first pass was handed out
+  bool started_ = false;
   uint32_t next_ = 0, nextToMerge_ = 0;
   uint64_t merged_ = 0;
   std::deque<uint32_t> requeued_;

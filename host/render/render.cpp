@@ -36,15 +36,18 @@ class StartLine {
   explicit StartLine(size_t devices) : devices_(devices) {}
   void arrive() {
     std::unique_lock<std::mutex> lock(mutex_);
-    ++arrived_;
+    if (++arrived_ == devices_) released_ = Clock::now();
     changed_.notify_all();
     changed_.wait(lock, [&] { return arrived_ == devices_; });
   }
+  // When the last device arrived: the render's clock starts there (set-up excluded).
+  Clock::time_point released() const { return released_; }
 
  private:
   std::mutex mutex_;
   std::condition_variable changed_;
   size_t devices_, arrived_ = 0;
+  Clock::time_point released_ = Clock::now();
 };
 
 // A device to render on: one set up already, or one to set up on the worker's thread (so
@@ -64,11 +67,10 @@ class Render {
         counts_(devices.size()), ends_(devices.size()), errors_(devices.size()) {}
 
   RenderResult run() {
-    const auto start = Clock::now();
     std::vector<std::thread> threads;
     for (size_t i = 0; i < devices_.size(); ++i) threads.emplace_back([this, i] { work(i); });
     for (auto& t : threads) t.join();
-    return collect(std::chrono::duration<double>(Clock::now() - start).count());
+    return collect(std::chrono::duration<double>(Clock::now() - startLine_.released()).count());
   }
 
  private:
