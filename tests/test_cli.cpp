@@ -4,7 +4,11 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <utility>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "image/image_io.h"
@@ -27,6 +31,13 @@ TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
       {"--width 100000 --height 100000", "is more than the 268 million pixels"},
       {"--camera /nonexistent/cam.json", "cannot open camera file"},
       {"/nonexistent/scene.obj", "/nonexistent/scene.obj: OBJ file not found"},
+      // Issue 17, rows 9-11 and 17.
+      {"--env=-1,0,0", "--env '-1,0,0': radiance cannot be negative"},
+      {"--time nan", "--time must be a finite number of seconds"},
+      {"--time inf", "--time must be a finite number of seconds"},
+      {"--spp 0", "--spp must be at least 1"},
+      {"--wavefront 0", "--wavefront must be at least 64"},
+      {"--spp 1 --spp 2", "fredholm: error: --spp"},
   };
   for (const auto& [flags, message] : cases) {
     const auto r = test::runFredholm(std::string("render ") + flags + " -o " + dir + "/x.png");
@@ -75,6 +86,97 @@ TEST(RenderCli, TimeBudgetEndsOnWholePasses) {
   EXPECT_GT(samples, 0u);
   EXPECT_EQ(samples % (32 * 32), 0u);           // every pixel has the same sample count
   EXPECT_LT(stats["seconds"].get<double>(), 10.0);  // the budget, plus the pass running then
+}
+
+// Ctrl-C or kill during a long render, on one device and on two: the passes finished so
+// far are written, the image says it is incomplete and how many samples it holds, and the
+// exit code is 128 + the signal, as for a process the signal killed (issue 17, row 5).
+TEST(RenderCli, ASignalWritesThePassesFinishedSoFar) {
+  const std::string dir = test::tempDir("signal");
+  const std::string env = "POCL_DEVICES='pthread basic'";
+  for (const std::string devices : {"0", "all"}) {
+    // A warm-up builds the kernels, so the signal lands while passes are being rendered.
+    const std::string size = " --width 32 --height 32 --device " + devices;
+    ASSERT_EQ(test::runFredholm("render" + size + " --spp 1 --force -o " + dir + "/warm.png", env).exitCode, 0);
+    for (const auto& [signal, code] : {std::pair<std::string, int>{"INT", 130}, {"TERM", 143}}) {
+      const std::string out = dir + "/" + signal + devices + ".exr";
+      const auto r = test::runCommand(env + " timeout --preserve-status -s " + signal + " 3 " + FREDHOLM_BINARY +
+                                      " render" + size + " --spp 1000000 -o " + out);
+      EXPECT_EQ(r.exitCode, code) << signal << " " << devices << ": " << r.output;
+      EXPECT_NE(r.output.find("fredholm: interrupted: wrote the "), std::string::npos) << r.output;
+      auto image = OIIO::ImageInput::open(out);
+      ASSERT_TRUE(image) << out << " was not written: " << r.output;
+      EXPECT_NE(image->spec().get_string_attribute("fredholm:incomplete").find("interrupted"), std::string::npos);
+      const double spp = std::stod(image->spec().get_string_attribute("fredholm:spp", "0"));
+      EXPECT_GE(spp, 1.0) << signal << " " << devices;
+      EXPECT_LT(spp, 1000000.0);
+      std::vector<float> pixels(32 * 32 * 3);
+      ASSERT_TRUE(image->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, pixels.data()));
+      double mean = 0;
+      for (float v : pixels) mean += v / double(pixels.size());
+      EXPECT_GT(mean, 0.01) << "the Cornell box is not black";
+    }
+  }
+}
+
+// A disk that fills mid-write, simulated by a file-size limit (with SIGXFSZ ignored a write
+// past it fails as on a full disk): a one-line error naming the file, exit 1, the file
+// that was there untouched and no temporary file left (issue 17, rows 6, 7 and 16).
+TEST(RenderCli, AFullDiskLeavesTheOldFileAndNoPartOfTheNew) {
+  const std::string dir = test::tempDir("full");
+  auto bytes = [](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  auto limited = [](const std::string& kib, const std::string& args) {
+    return test::runCommand("bash -c 'ulimit -f " + kib + "; trap \"\" XFSZ; exec " + FREDHOLM_BINARY + " " +
+                            args + "'");
+  };
+  const std::string size = "render --width 128 --height 128 --spp 2 --force";
+  for (const std::string ext : {".png", ".exr"}) {
+    const std::string image = dir + "/image" + ext;
+    // Also builds the kernels, so the limited run has nothing to write but its outputs.
+    ASSERT_EQ(test::runFredholm(size + " -o " + image).exitCode, 0);
+    const std::string before = bytes(image);
+    const auto r = limited("4", size + " --seed 2 -o " + image);
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find("fredholm: error: image '" + image + "': cannot write"), std::string::npos) << r.output;
+    EXPECT_EQ(bytes(image), before) << ext << " was changed";
+  }
+  const std::string stats = dir + "/s.json";
+  test::writeFile(stats, "{}\n");
+  const auto r = limited("1", "render --width 8 --height 8 --spp 1 --force -o " + dir + "/small.pfm --stats " + stats);
+  EXPECT_EQ(r.exitCode, 1) << r.output;
+  EXPECT_NE(r.output.find("fredholm: error: --stats '" + stats + "': cannot write"), std::string::npos) << r.output;
+  EXPECT_EQ(bytes(stats), "{}\n");
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    EXPECT_EQ(entry.path().filename().string().find("fredholm-tmp"), std::string::npos) << entry.path();
+}
+
+// A wavefront larger than the passes in flight can fill is cut to what they can (row 12).
+TEST(RenderCli, WavefrontIsCappedAtWhatTheImageCanUse) {
+  const std::string dir = test::tempDir("cli");
+  const auto r = test::runFredholm("render --width 16 --height 16 --spp 4 --wavefront 100000000 -o " + dir +
+                                   "/w.pfm --stats " + dir + "/s.json");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  std::ifstream in(dir + "/s.json");
+  const auto stats = nlohmann::json::parse(in);
+  EXPECT_LE(stats["wavefront"].get<size_t>(), 8u * 16u * 16u);
+  EXPECT_EQ(stats["samples"], 16 * 16 * 4);
+}
+
+// A texture that cannot be decoded is named in a warning with its material (row 8).
+TEST(RenderCli, AnUnreadableTextureIsAWarningNamingItAndItsMaterial) {
+  const std::string dir = test::tempDir("cli");
+  test::writeFile(dir + "/t.obj", "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                                  "usemtl painted\nf 1/1 2/2 3/3\n");
+  test::writeFile(dir + "/t.mtl", "newmtl painted\nKd 0.5 0.5 0.5\nKe 1 1 1\nmap_Kd broken.png\n");
+  test::writeFile(dir + "/broken.png", "not an image\n");
+  const auto r = test::runFredholm("render " + dir + "/t.obj --width 8 --height 8 --spp 1 --eye 0.3,0.3,2 "
+                                   "--target 0.3,0.3,0 -o " + dir + "/t.pfm");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("fredholm: warning: material 'painted': "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("broken.png"), std::string::npos) << r.output;
 }
 
 TEST(RenderCli, ProgressLinesWhenNotATerminal) {

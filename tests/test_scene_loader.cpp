@@ -1,6 +1,7 @@
 // Scene loading: every shared scene loads with the counts its README states, and every
 // bad input gives a clear error naming the file (and line) or a documented warning.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <filesystem>
@@ -210,6 +211,58 @@ TEST_F(BadInput, IndicesOutOfRange) {
             std::string::npos);
   EXPECT_NE(errorFor(std::string(kTriangle) + "vn 0 0 1\nf 1//1 2//2 3//1\n").find("scene.obj:5: normal index 2"),
             std::string::npos);
+}
+
+// Found by fuzzing (issue 17, rows 1-4): inputs the lint passed and the loader read
+// differently, which crashed or sent out-of-range indices to the device.
+TEST_F(BadInput, FaceElementEndingInASlash) {
+  EXPECT_NE(errorFor("v 1 0 0\nv 0 1 0\nv 0 1 0\nf 1/ 2 3\n").find("scene.obj:4: face element '1/' ends in '/'"),
+            std::string::npos);
+  EXPECT_NE(errorFor(std::string(kTriangle) + "f 1// 2 3\n").find("scene.obj:4: face element '1//' ends in '/'"),
+            std::string::npos);
+}
+
+TEST_F(BadInput, LinesSplitOnlyWhereTheLoaderSplitsThem) {
+  EXPECT_NE(errorFor("v\r1 1 0\nf 1 1 1\n").find("scene.obj:1: a carriage return without a line feed"),
+            std::string::npos);
+  // A lone CR ends a comment for the loader: the face behind it must not pass unchecked.
+  EXPECT_NE(errorFor(std::string(kTriangle) + "# c\rf 1 2 99\nf 1 2 3\n").find("scene.obj:4: a carriage return"),
+            std::string::npos);
+  EXPECT_NE(errorFor(std::string(kTriangle) + "\vv 1 1 0\nf 1 2 3\n").find("scene.obj:4: control character 0x0b"),
+            std::string::npos);
+  EXPECT_NE(errorFor(std::string(kTriangle) + "f 1 2 3\n" + std::string(1, '\0') + "f 1 2 99\n")
+                .find("scene.obj:5: control character 0x00"),
+            std::string::npos);
+  EXPECT_NE(errorFor("mtllib scene.mtl\n" + std::string(kTriangle) + "usemtl a\nf 1 2 3\n", "newmtl a\rKd 1 1 1\n")
+                .find("scene.mtl:1: a carriage return"),
+            std::string::npos);
+}
+
+TEST_F(BadInput, IndicesBeyondAnyIntegerType) {
+  EXPECT_NE(errorFor(std::string(kTriangle) + "f -9223372036854775808 2 3\n").find("scene.obj:4: face element"),
+            std::string::npos);
+  EXPECT_NE(errorFor(std::string(kTriangle) + "f 1 99999999999999999999 3\n").find("out of any file's range"),
+            std::string::npos);
+}
+
+// Devices and FIFOs would block or never end: refused by name (issue 17, row 13).
+TEST_F(BadInput, FilesThatAreNotRegularFiles) {
+  EXPECT_NE(errorFor("mtllib /dev/zero\n" + std::string(kTriangle) + "f 1 2 3\n").find("/dev/zero: not a regular file"),
+            std::string::npos);
+  ASSERT_EQ(::mkfifo(path("fifo.obj").c_str(), 0600), 0);
+  try {
+    loadScene(path("fifo.obj"));
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("fifo.obj: not a regular file"), std::string::npos) << e.what();
+  }
+  writeFile(path("t.mtl"), "newmtl a\nKd 1 1 1\nmap_Kd fifo.obj\n");
+  writeFile(path("t.obj"), "mtllib t.mtl\n" + std::string(kTriangle) + "usemtl a\nf 1 2 3\n");
+  const Scene scene = loadScene(path("t.obj"));
+  bool warned = false;
+  for (const auto& w : scene.warnings) warned = warned || w.find("is not a regular file") != std::string::npos;
+  EXPECT_TRUE(warned);
+  EXPECT_TRUE(scene.textures.empty());
 }
 
 TEST_F(BadInput, MissingMtl) {

@@ -28,4 +28,15 @@ class BuildError : public Error {
   using Error::Error;
 };
 
+// The user stopped the program (SIGINT, SIGTERM): main reports it and exits with
+// 128 + the signal's number, as a shell does for a process the signal killed.
+class Interrupted : public Error {
+ public:
+  Interrupted(const std::string& what, int signal) : Error(what), signal_(signal) {}
+  int exitCode() const { return 128 + signal_; }
+
+ private:
+  int signal_;
+};
+
 }  // namespace fh

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "accel/bvh.h"
+#include "base/atomic_file.h"
 #include "base/error.h"
 #include "base/vec.h"
 #include "bench/bench_scenes.h"
@@ -238,9 +239,7 @@ int runBench(const BenchOptions& o) {
                           {"repeats", o.repeats},
                           {"scenes", sceneInfo},
                           {"records", records}};
-    std::ofstream out(o.jsonPath);
-    out << doc.dump(2) << "\n";
-    if (!out) throw Error("--json '" + o.jsonPath + "': cannot write");
+    writeTextAtomically(o.jsonPath, "--json", doc.dump(2) + "\n");
     std::cout << "wrote " << o.jsonPath << "\n";
   }
   return 0;

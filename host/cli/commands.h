@@ -13,11 +13,12 @@ struct RenderOptions {
   std::string scene;
   std::string output;
   bool force = false;
-  int width = 512, height = 512, spp = 0;
+  int width = 512, height = 512;
+  std::optional<int> spp;  // unset: 64 (4 for --aov), or as many as --time allows
   double seconds = 0.0;
   std::string method = "mis", filter = "box", env, statsFile;
   int maxDepth = 64;
-  size_t wavefront = 0;
+  std::optional<size_t> wavefront;  // unset: chosen for each device
   bool allFeatures = false;
   unsigned seed = 1;
   std::string cameraFile, eye, target, up;

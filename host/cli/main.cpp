@@ -129,7 +129,9 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::cerr << "fredholm: error: " << e.what() << " (see fredholm " << (app.get_subcommands().empty() ? "" : app.get_subcommands().front()->get_name() + " ") << "--help)\n";
+    return 1;
   }
   try {
     if (*devices) return runDevices(devicesSpec);
@@ -138,6 +140,9 @@ int main(int argc, char** argv) {
     if (*referencing) return runReference(reference);
     if (*comparing) return runCompare(compare);
     if (*exporter) return runExport(exporting);
+  } catch (const Interrupted& e) {
+    std::cerr << "fredholm: interrupted: " << e.what() << "\n";
+    return e.exitCode();
   } catch (const BuildError& e) {
     std::cerr << "fredholm: error: " << e.what() << "\n";
     return 1;

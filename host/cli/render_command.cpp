@@ -1,15 +1,18 @@
 // `fredholm render`: flags checked before any work, then scene, camera, BVH, one render on
 // every device --device selects, and the image with its metadata.
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
 #include <sstream>
 
+#include "base/atomic_file.h"
 #include "base/vec.h"
 #include "cli/commands.h"
 #include "cli/flags.h"
+#include "cli/interrupt.h"
 #include "device/devices.h"
 #include "image/image_io.h"
 #include "render/render.h"
@@ -61,25 +64,26 @@ RenderSettings settingsFrom(const RenderOptions& o) {
   s.method = parseMethod(o.method);
   s.filter = parseFilter(o.filter);
   if (!o.env.empty()) s.env = parseVec3Flag("--env", o.env);
+  if (s.env[0] < 0 || s.env[1] < 0 || s.env[2] < 0) throw Error("--env '" + o.env + "': radiance cannot be negative");
   if (o.width <= 0 || o.height <= 0) throw Error("--width/--height must be positive");
   // Pixels are indexed in 32 bits on the device, with room for several pass buffers.
   if (uint64_t(o.width) * uint64_t(o.height) > (uint64_t(1) << 28))
     throw Error("--width/--height: " + std::to_string(o.width) + "x" + std::to_string(o.height) +
                 " is more than the 268 million pixels fredholm renders in one image");
-  if (o.spp < 0) throw Error("--spp must be positive");
-  if (o.seconds < 0) throw Error("--time must be positive");
+  if (o.spp && *o.spp < 1) throw Error("--spp must be at least 1");
+  if (!std::isfinite(o.seconds) || o.seconds < 0) throw Error("--time must be a finite number of seconds");
   if (o.maxDepth < 1) throw Error("--max-depth must be at least 1");
-  if (o.wavefront != 0 && o.wavefront < kLocalSize) throw Error("--wavefront must be at least 64");
+  if (o.wavefront && *o.wavefront < kLocalSize) throw Error("--wavefront must be at least 64");
   const uint64_t pixels = uint64_t(o.width) * uint64_t(o.height);
   s.width = o.width;
   s.height = o.height;
-  s.spp = o.spp > 0 ? o.spp
-                    : (o.seconds > 0 ? int(std::min<uint64_t>(1 << 20, 0xFFFFFFFFull / pixels))
-                                     : (o.aov.empty() ? 64 : 4));
+  s.spp = o.spp ? *o.spp
+                : (o.seconds > 0 ? int(std::min<uint64_t>(1 << 20, 0xFFFFFFFFull / pixels))
+                                 : (o.aov.empty() ? 64 : 4));
   s.seconds = o.seconds;
   s.maxDepth = o.maxDepth;
   s.seed = o.seed;
-  s.wavefront = o.wavefront;
+  s.wavefront = o.wavefront.value_or(0);
   s.allFeatures = o.allFeatures;
   s.progress = true;
   return s;
@@ -104,10 +108,12 @@ RenderResult renderDebugView(const RenderOptions& o, const std::vector<DeviceInf
   }
   r.stats.samples = uint64_t(s.spp) * r.film.pixels();
   r.stats.devices.push_back({devices[0].name, r.stats.samples, 0, 0.0, 0.0, ""});
+  r.stopped = s.stopRequested();  // a debug view finishes once started
   return r;
 }
 
 void reportDevices(const RenderResult& r) {
+  for (const auto& w : r.warnings) std::cerr << "fredholm: warning: " << w << "\n";
   for (const auto& d : r.stats.devices)
     if (!d.error.empty())
       std::cerr << "fredholm: warning: device " << d.name << " failed: " << d.error
@@ -119,7 +125,8 @@ void reportDevices(const RenderResult& r) {
 }  // namespace
 
 int runRender(RenderOptions o) {
-  const RenderSettings settings = settingsFrom(o);
+  RenderSettings settings = settingsFrom(o);
+  settings.stop = &installInterruptHandlers();
   if (!o.aov.empty()) parseAov(o.aov);
   // An explicit -o is never overwritten without --force; the default name steps aside.
   if (o.output.empty()) o.output = firstFreeName("fredholm.png");
@@ -142,9 +149,7 @@ int runRender(RenderOptions o) {
   const std::string method = debugView ? "aov:" + o.aov : methodName(settings.method);
   reportDevices(r);
   if (!o.statsFile.empty() && !debugView) {
-    std::ofstream out(o.statsFile);
-    out << statsJson(r.stats, settings) << "\n";
-    if (!out) throw Error("--stats '" + o.statsFile + "': cannot write");
+    writeTextAtomically(o.statsFile, "--stats", statsJson(r.stats, settings) + "\n");
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double spp = double(r.stats.samples) / double(r.film.pixels());
@@ -153,11 +158,19 @@ int runRender(RenderOptions o) {
                             {"device", devicesUsed}, {"seed", std::to_string(o.seed)},
                             {"seconds", formatSeconds(seconds)}, {"filter", o.filter},
                             {"max_depth", std::to_string(o.maxDepth)}};
+  const std::string passes = std::to_string(r.stats.samples / r.film.pixels()) + " passes";
+  if (r.stopped) {
+    const int signal = settings.stop->load();
+    if (r.stats.samples == 0) throw Interrupted("before any pass was finished; nothing written", signal);
+    metadata["incomplete"] = "interrupted by signal " + std::to_string(signal);
+    writeImage(o.output, r.film.image(), metadata);
+    throw Interrupted("wrote the " + passes + " finished so far to " + o.output, signal);
+  }
   if (!r.complete) {
     metadata["incomplete"] = "every device failed";
     writeImage(o.output, r.film.image(), metadata);
-    throw Error("every device failed before the render was complete; wrote the " +
-                std::to_string(r.stats.samples / r.film.pixels()) + " passes finished so far to " + o.output);
+    throw Error("every device failed before the render was complete; wrote the " + passes +
+                " finished so far to " + o.output);
   }
   writeImage(o.output, r.film.image(), metadata);
   std::cerr << "fredholm: rendered " << scene.sourcePath << " (" << scene.triangleCount() << " triangles, "

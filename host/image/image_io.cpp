@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "base/atomic_file.h"
 #include "base/error.h"
 
 namespace fh {
@@ -30,13 +31,14 @@ std::string extensionOf(const std::string& path) {
 // "PF", width height, a negative scale for little-endian, then rows bottom to top.
 void writePfm(const std::string& path, const Image& image) {
   std::ofstream out(path, std::ios::binary);
-  if (!out) throw Error("cannot write '" + path + "'");
+  if (!out) throw Error("cannot create the file");
   out << "PF\n" << image.width << " " << image.height << "\n-1.0\n";
   static_assert(sizeof(float) == 4, "PFM stores 32-bit floats");
   for (int y = image.height - 1; y >= 0; --y)
     out.write(reinterpret_cast<const char*>(&image.rgb[size_t(y) * size_t(image.width) * 3]),
               std::streamsize(size_t(image.width) * 3 * sizeof(float)));
-  if (!out) throw Error("cannot write '" + path + "': write failed");
+  out.close();
+  if (!out) throw Error("the write failed (disk full?)");
 }
 
 Image readPfm(const std::string& path) {
@@ -103,18 +105,21 @@ std::string firstFreeName(const std::string& path) {
   }
 }
 
-void writeImage(const std::string& path, const Image& image, const std::map<std::string, std::string>& metadata) {
-  const ImageEncoding encoding = checkOutputPath(path, true);
+namespace {
+
+// Encodes `image` into the file `path` by its extension.
+void encodeImage(const std::string& path, const Image& image, ImageEncoding encoding,
+                 const std::map<std::string, std::string>& metadata) {
   if (extensionOf(path) == ".pfm") return writePfm(path, image);
 #ifdef FREDHOLM_HAVE_OIIO
   auto out = OIIO::ImageOutput::create(path);
-  if (!out) throw Error("cannot write '" + path + "': " + OIIO::geterror());
+  if (!out) throw Error(OIIO::geterror());
   const bool isFloat = encoding == ImageEncoding::LinearFloat;
   OIIO::ImageSpec spec(image.width, image.height, 3, isFloat ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
   for (const auto& [key, value] : metadata) spec.attribute("fredholm:" + key, value);
   spec.attribute("Software", "fredholm " FREDHOLM_VERSION);
   if (!isFloat) spec.attribute("oiio:ColorSpace", "sRGB");
-  if (!out->open(path, spec)) throw Error("cannot write '" + path + "': " + out->geterror());
+  if (!out->open(path, spec)) throw Error(out->geterror());
   bool ok;
   if (isFloat) {
     ok = out->write_image(OIIO::TypeDesc::FLOAT, image.rgb.data());
@@ -124,11 +129,51 @@ void writeImage(const std::string& path, const Image& image, const std::map<std:
       bytes[i] = static_cast<unsigned char>(std::lround(255.f * linearToSrgb(image.rgb[i])));
     ok = out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
   }
-  if (!ok || !out->close()) throw Error("cannot write '" + path + "': " + out->geterror());
+  if (!ok || !out->close()) throw Error(out->geterror());
 #else
   (void)encoding;
   (void)metadata;
 #endif
+}
+
+// The file ends in `trailer`.
+bool endsWith(const std::string& path, const std::string& trailer) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  const auto size = static_cast<long long>(in.tellg());
+  if (!in || size < static_cast<long long>(trailer.size())) return false;
+  in.seekg(size - static_cast<long long>(trailer.size()));
+  std::string tail(trailer.size(), '\0');
+  in.read(&tail[0], std::streamsize(tail.size()));
+  return in && tail == trailer;
+}
+
+// Some encoders (libpng and libjpeg through OpenImageIO) do not report a failed write. A PNG
+// or JPEG must end in its end marker (reading one back would have libpng print to stderr);
+// other formats are read back and must decode to the image's size.
+void checkComplete(const std::string& path, const Image& image) {
+  const std::string ext = extensionOf(path);
+  if (ext == ".png" || ext == ".jpg" || ext == ".jpeg") {
+    static const std::string iend("\0\0\0\0IEND\xae\x42\x60\x82", 12), eoi("\xff\xd9", 2);
+    if (!endsWith(path, ext == ".png" ? iend : eoi)) throw Error("the file written is cut short (disk full?)");
+    return;
+  }
+  Image back;
+  try {
+    back = readImage(path);
+  } catch (const Error&) {
+    throw Error("the file written does not decode (disk full?)");
+  }
+  if (back.width != image.width || back.height != image.height)
+    throw Error("the file written does not decode to the image's size");
+}
+
+}  // namespace
+
+void writeImage(const std::string& path, const Image& image, const std::map<std::string, std::string>& metadata) {
+  const ImageEncoding encoding = checkOutputPath(path, true);
+  writeAtomically(
+      path, "image", [&](const std::string& temp) { encodeImage(temp, image, encoding, metadata); },
+      [&](const std::string& temp) { checkComplete(temp, image); });
 }
 
 Image readImage(const std::string& path) {

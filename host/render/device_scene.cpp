@@ -166,12 +166,16 @@ DeviceScene::DeviceScene(DeviceContext& dc, const Scene& scene, const Bvh& hostB
   std::vector<float> allTexels;
   std::vector<uint32_t> info;
   if (f.textures) {
-    for (const Texture& tex : scene.textures) {
+    for (size_t index = 0; index < scene.textures.size(); ++index) {
+      const Texture& tex = scene.textures[index];
       TextureData t;
       try {
         t = loadTexture(tex.path);
       } catch (const Error& e) {
-        warnings.push_back(std::string(e.what()) + "; using a grey texel");
+        std::string users;
+        for (const Material& m : scene.materials)
+          if (m.kdTexture == int(index)) users += (users.empty() ? "material '" : ", '") + m.name + "'";
+        warnings.push_back(users + ": " + e.what() + "; using a grey texel");
         t.width = t.height = 1;
         t.texels = {0.5f, 0.5f, 0.5f, 1.f};
       }

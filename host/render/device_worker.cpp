@@ -9,9 +9,9 @@ namespace fh {
 // idle waiting for the host, few enough that finished passes leave soon.
 constexpr int kIterationsPerBatch = 8;
 
-void DeviceWorker::run() {
+void DeviceWorker::run(const RenderSettings& settings) {
   takePasses();
-  while (returned_ < granted_) {
+  while (returned_ < granted_ && !settings.stopRequested()) {
     for (int i = 0; i < kIterationsPerBatch; ++i) pipeline_.enqueueIteration();
     pipeline_.readCounters();
     returnCompletePasses();

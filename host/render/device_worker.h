@@ -13,9 +13,10 @@ class DeviceWorker {
   DeviceWorker(int index, WavefrontPipeline& pipeline, PassSource& source, long failAfter = -1)
       : index_(index), pipeline_(pipeline), source_(source), failAfter_(failAfter) {}
 
-  // Renders until the source has nothing more for this device. Throws if the device fails;
-  // the caller then tells the source (fail), which gives its passes to the others.
-  void run();
+  // Renders until the source has nothing more for this device, or `stop` is set (passes in
+  // flight are then dropped). Throws if the device fails; the caller then tells the source
+  // (fail), which gives its passes to the others.
+  void run(const RenderSettings& settings);
   uint64_t passesDone() const { return returned_; }
 
  private:

@@ -45,6 +45,7 @@ bool PassPool::take(int worker, uint32_t& pass) {
     started_ = true;
   }
   for (;;) {
+    if (settings_.stopRequested()) return false;
     if (!requeued_.empty()) {
       pass = requeued_.front();
       requeued_.pop_front();
@@ -89,7 +90,7 @@ uint64_t PassPool::passesDone(int worker) const {
 Film PassPool::finish(bool& complete) {
   stopMerging();
   std::lock_guard<std::mutex> lock(mutex_);
-  complete = pending_.empty() && requeued_.empty();
+  complete = pending_.empty() && requeued_.empty() && !anyOutstanding();
   for (auto& [pass, samples] : pending_) {
     film_.addPass(samples);
     ++merged_;

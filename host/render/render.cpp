@@ -64,7 +64,7 @@ class Render {
          const RenderSettings& settings)
       : devices_(devices), scene_(scene), bvh_(bvh), camera_(camera), settings_(settings),
         pool_(settings, int(devices.size())), startLine_(devices.size()), shares_(devices.size()),
-        counts_(devices.size()), ends_(devices.size()), errors_(devices.size()) {}
+        counts_(devices.size()), ends_(devices.size()), errors_(devices.size()), warnings_(devices.size()) {}
 
   RenderResult run() {
     std::vector<std::thread> threads;
@@ -88,10 +88,12 @@ class Render {
       perDevice.progress = false;  // the pool shows the render's progress
       WavefrontPipeline pipeline(dc, scene_, bvh_, camera_, perDevice);
       share.wavefront = pipeline.wavefront();
+      warnings_[i] = pipeline.sceneWarnings();
       started = true;
       startLine_.arrive();
       begin = Clock::now();
-      DeviceWorker(int(i), pipeline, pool_, simulatedFailure(int(i))).run();
+      DeviceWorker(int(i), pipeline, pool_, simulatedFailure(int(i))).run(settings_);
+      if (settings_.stopRequested()) pool_.fail(int(i));  // wakes workers waiting for its passes
       FH_CL(dc.queue.finish());
       counts_[i] = pipeline.stats();
     } catch (const std::exception& e) {
@@ -109,10 +111,14 @@ class Render {
   RenderResult collect(double seconds) {
     uint64_t passes = 0;
     for (size_t i = 0; i < devices_.size(); ++i) passes += pool_.passesDone(int(i));
-    if (passes == 0 && std::all_of(errors_.begin(), errors_.end(), [](const auto& e) { return e != nullptr; }))
+    if (passes == 0 && !settings_.stopRequested() &&
+        std::all_of(errors_.begin(), errors_.end(), [](const auto& e) { return e != nullptr; }))
       std::rethrow_exception(errors_.front());
     RenderResult result;
     result.film = pool_.finish(result.complete);
+    result.stopped = settings_.stopRequested();
+    for (const auto& w : warnings_)
+      if (result.warnings.empty()) result.warnings = w;
     RenderStats& st = result.stats;
     st.seconds = seconds;
     st.devices = shares_;
@@ -138,6 +144,7 @@ class Render {
   std::vector<RenderStats> counts_;
   std::vector<Clock::time_point> ends_;
   std::vector<std::exception_ptr> errors_;
+  std::vector<std::vector<std::string>> warnings_;  // every device reads the same scene: shown once
 };
 
 }  // namespace

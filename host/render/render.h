@@ -4,6 +4,7 @@
 // device is a pool with one worker, so every render takes the same path and a seed gives
 // the same image on one device as on several (when the devices compute alike).
 #pragma once
+#include <string>
 #include <vector>
 
 #include "accel/bvh.h"
@@ -20,7 +21,9 @@ namespace fh {
 struct RenderResult {
   Film film;
   RenderStats stats;      // totals, with stats.devices holding each device's share
-  bool complete = true;   // false if every device failed before the last pass
+  bool complete = true;      // false if a pass was never rendered (every device failed, or stopped)
+  bool stopped = false;      // settings.stop was set: the film holds the passes finished before it
+  std::vector<std::string> warnings;  // from setting the scene up on the devices (unreadable textures)
 };
 
 // A device that fails is reported in stats.devices[i].error; the passes it had taken are

@@ -3,6 +3,7 @@
 // of a render.
 #pragma once
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <string>
 
@@ -27,6 +28,10 @@ struct RenderSettings {
   size_t wavefront = 0;  // paths in flight per device; 0: chosen for each device
   bool progress = false;
   bool allFeatures = false;  // compile every material feature, not only the scene's (benchmarks)
+  // Set (non-zero) to stop early, as Ctrl-C does: passes in flight are dropped, those
+  // finished are kept. Null: never.
+  const std::atomic<int>* stop = nullptr;
+  bool stopRequested() const { return stop && stop->load() != 0; }
 };
 
 }  // namespace fh

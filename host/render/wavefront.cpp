@@ -78,7 +78,9 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
       method_(s.method),
       scene_(dc, scene, bvh, s.allFeatures ? SceneFeatures::all() : sceneFeatures(scene)),
       pixels_(unsigned(s.width) * unsigned(s.height)) {
-  wavefront_ = s.wavefront ? s.wavefront : defaultWavefront(dc.info, pixels_);
+  // No more paths than the passes in flight can ever hold.
+  const size_t most = roundUp(size_t(FH_MAX_PASS_SLOTS) * pixels_, kLocalSize);
+  wavefront_ = std::min(s.wavefront ? s.wavefront : defaultWavefront(dc.info, pixels_), most);
   std::vector<float> filterTable;
   params_ = renderParams(s, camera, scene_.lightCount, filterTable);
   // Enough passes in flight that the wavefront stays full while a pass's longest paths

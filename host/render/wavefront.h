@@ -74,6 +74,8 @@ class WavefrontPipeline {
   // This device's counts so far (samples are the film's to count) and stage times.
   RenderStats stats();
   size_t wavefront() const { return wavefront_; }
+  // What uploading the scene found (textures that could not be read).
+  const std::vector<std::string>& sceneWarnings() const { return scene_.warnings; }
 
  private:
   // The stages; each launches its kernel, bound for the current parity.

@@ -4,6 +4,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <iomanip>
 #include <set>
 #include <sstream>
 
@@ -12,24 +13,50 @@
 namespace fh {
 namespace {
 
+// The lint must read the lines and tokens the loader (tinyobjloader) reads, or it checks
+// other statements than those loaded. The two agree on lines that end in \n or \r\n and on
+// tokens separated by spaces and tabs; they split differently at a lone \r (a line end to
+// tinyobjloader), at \v, \f and NUL. Text holding those is refused, naming the line.
+void requirePlainText(const std::string& text, const std::string& name) {
+  int line = 1;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c == '\n') ++line;
+    const bool crlf = c == '\r' && i + 1 < text.size() && text[i + 1] == '\n';
+    if ((c < 0x20 && c != '\n' && c != '\t' && !crlf) || c == 0x7f) {
+      std::ostringstream msg;
+      msg << name << ":" << line << ": ";
+      if (c == '\r') msg << "a carriage return without a line feed (old Mac line ends): use \\n or \\r\\n";
+      else msg << "control character 0x" << std::hex << std::setw(2) << std::setfill('0') << int(c)
+               << " (lines hold text, spaces and tabs)";
+      throw Error(msg.str());
+    }
+  }
+}
+
 struct LineReader {
   std::istringstream in;
   std::string name;
   int number = 0;
 
-  LineReader(const std::string& text, std::string n) : in(text), name(std::move(n)) {}
+  LineReader(const std::string& text, std::string n) : in(text), name(std::move(n)) {
+    requirePlainText(text, name);
+  }
 
-  // The next line split into whitespace tokens, comments and CR removed.
+  // The next line split into tokens at spaces and tabs, comments and a final CR removed.
   bool next(std::vector<std::string>& tokens) {
     std::string line;
     if (!std::getline(in, line)) return false;
     ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
     if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
-    for (char& c : line)
-      if (c == '\r' || c == '\t') c = ' ';
     tokens.clear();
-    std::istringstream words(line);
-    for (std::string w; words >> w;) tokens.push_back(w);
+    size_t start = 0;
+    while ((start = line.find_first_not_of(" \t", start)) != std::string::npos) {
+      const size_t end = line.find_first_of(" \t", start);
+      tokens.push_back(line.substr(start, end == std::string::npos ? std::string::npos : end - start));
+      start = end;
+    }
     return true;
   }
 
@@ -75,6 +102,8 @@ struct IndexCheck {
 // (negative) ones point at an element already defined.
 void checkFaceToken(const LineReader& r, const std::string& token, const size_t counts[3], IndexCheck checks[3]) {
   static const char* kinds[3] = {"vertex", "texture coordinate", "normal"};
+  // "1/" and "1//": tinyobjloader reads a missing index after a final slash as index 0.
+  if (token.back() == '/') r.fail("face element '" + token + "' ends in '/' (give the index or drop the slash)");
   size_t start = 0;
   for (int slot = 0; slot < 3 && start <= token.size(); ++slot) {
     const size_t slash = token.find('/', start);
@@ -85,8 +114,11 @@ void checkFaceToken(const LineReader& r, const std::string& token, const size_t 
       continue;
     }
     char* end = nullptr;
+    errno = 0;
     const long index = std::strtol(part.c_str(), &end, 10);
     if (*end != '\0') r.fail("face element '" + token + "' has a non-integer index '" + part + "'");
+    if (errno == ERANGE || index < -(1L << 40) || index > (1L << 40))
+      r.fail("face element '" + token + "' has an index out of any file's range");
     if (index == 0) r.fail("face element '" + token + "' uses index 0 (OBJ indices start at 1)");
     if (index < 0) {
       if (static_cast<size_t>(-index) > counts[slot]) {

@@ -33,6 +33,8 @@ std::string readTextFile(const fs::path& path, const std::string& what) {
   const auto status = fs::status(path, ec);
   if (ec || !fs::exists(status)) throw Error(path.string() + ": " + what + " not found");
   if (fs::is_directory(status)) throw Error(path.string() + ": is a directory, not " + what);
+  // A device, FIFO or socket could block or never end (/dev/zero).
+  if (!fs::is_regular_file(status)) throw Error(path.string() + ": not a regular file, so not " + what);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path.string() + ": cannot open " + what);
   std::ostringstream text;
@@ -101,6 +103,12 @@ void addTextures(Scene& scene, const std::vector<tinyobj::material_t>& source, c
                                "' not found; using its Kd instead");
       continue;
     }
+    std::error_code ec;
+    if (!fs::is_regular_file(resolved, ec)) {  // a directory, a device, a FIFO
+      scene.warnings.push_back("material '" + source[i].name + "': texture '" + resolved.string() +
+                               "' is not a regular file; using its Kd instead");
+      continue;
+    }
     const std::string key = resolved.string();
     auto it = byPath.find(key);
     if (it == byPath.end()) {
@@ -111,6 +119,25 @@ void addTextures(Scene& scene, const std::vector<tinyobj::material_t>& source, c
   }
 }
 
+
+// Every index tinyobjloader produced refers to an element it read. The lint checks the file
+// first, naming the line; this is the last line of defence should the two ever read a file
+// differently, so that no index leaves the loader unchecked.
+void checkIndices(const std::string& objName, const tinyobj::attrib_t& attrib,
+                  const std::vector<tinyobj::shape_t>& shapes) {
+  const size_t vertices = attrib.vertices.size() / 3, normals = attrib.normals.size() / 3,
+               texcoords = attrib.texcoords.size() / 2;
+  for (const auto& shape : shapes) {
+    if (shape.mesh.indices.size() != 3 * shape.mesh.num_face_vertices.size() ||
+        shape.mesh.material_ids.size() != shape.mesh.num_face_vertices.size())
+      throw Error(objName + ": faces were not triangulated as expected");
+    for (const auto& idx : shape.mesh.indices)
+      if (idx.vertex_index < 0 || size_t(idx.vertex_index) >= vertices ||
+          (idx.normal_index >= 0 && size_t(idx.normal_index) >= normals) ||
+          (idx.texcoord_index >= 0 && size_t(idx.texcoord_index) >= texcoords))
+        throw Error(objName + ": a face refers to a vertex, normal or texture coordinate the file does not define");
+  }
+}
 
 void flattenShapes(Scene& scene, const tinyobj::attrib_t& attrib, const std::vector<tinyobj::shape_t>& shapes,
                    int defaultMaterial) {
@@ -128,7 +155,7 @@ void flattenShapes(Scene& scene, const tinyobj::attrib_t& attrib, const std::vec
       const size_t base = 3 * f;
       for (int k = 0; k < 3; ++k) scene.indices.push_back(unsigned(mesh.indices[base + size_t(k)].vertex_index));
       int material = mesh.material_ids[f];
-      if (material < 0) {
+      if (material < 0 || material >= defaultMaterial) {
         material = defaultMaterial;
         ++noMaterial;
       }
@@ -186,6 +213,7 @@ Scene buildScene(const SceneText& text, const ObjLintReport& report) {
   grey.name = "default";
   scene.materials.push_back(grey);
 
+  checkIndices(text.objName, reader.GetAttrib(), reader.GetShapes());
   flattenShapes(scene, reader.GetAttrib(), reader.GetShapes(), defaultMaterial);
   if (scene.triangleCount() == 0) throw Error(text.objName + ": no triangles after triangulation");
   addTextures(scene, source, text.baseDir);

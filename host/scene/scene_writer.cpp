@@ -2,10 +2,11 @@
 #include "scene/scene_writer.h"
 
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
+#include "base/atomic_file.h"
 #include "base/error.h"
 #include "image/image_io.h"
 
@@ -14,19 +15,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::ofstream openForWriting(const std::string& path) {
-  std::ofstream out(path);
-  if (!out) throw Error(path + ": cannot open for writing");
+// Each file is composed in memory and written whole (base/atomic_file.h).
+std::ostringstream textWriter() {
+  std::ostringstream out;
   out << std::setprecision(9);  // round-trips a float
   return out;
 }
 
-void writeTriple(std::ofstream& out, const char* key, const Vec3f& v) {
+void writeTriple(std::ostringstream& out, const char* key, const Vec3f& v) {
   out << key << ' ' << v[0] << ' ' << v[1] << ' ' << v[2] << '\n';
 }
 
-void writeMtl(const Scene& scene, const std::string& path) {
-  std::ofstream out = openForWriting(path);
+std::string mtlText(const Scene& scene) {
+  std::ostringstream out = textWriter();
   out << "# written by fredholm export from " << scene.sourcePath << "\n";
   for (const Material& m : scene.materials) {
     out << "\nnewmtl " << m.name << '\n';
@@ -37,10 +38,11 @@ void writeMtl(const Scene& scene, const std::string& path) {
     out << "Ns " << m.ns << "\nNi " << m.ni << "\nd " << m.d << "\nillum " << m.illum << '\n';
     if (m.kdTexture >= 0) out << "map_Kd " << fs::absolute(scene.textures[size_t(m.kdTexture)].path).string() << '\n';
   }
+  return out.str();
 }
 
-void writeObj(const Scene& scene, const std::string& path, const std::string& mtlName) {
-  std::ofstream out = openForWriting(path);
+std::string objText(const Scene& scene, const std::string& mtlName) {
+  std::ostringstream out = textWriter();
   out << "# written by fredholm export from " << scene.sourcePath << "\nmtllib " << mtlName << '\n';
   for (size_t v = 0; v < scene.vertexCount(); ++v) writeTriple(out, "v", scene.vertex(unsigned(v)));
   const bool normals = !scene.cornerNormals.empty(), uvs = !scene.cornerUVs.empty();
@@ -64,12 +66,12 @@ void writeObj(const Scene& scene, const std::string& path, const std::string& mt
     }
     out << '\n';
   }
+  return out.str();
 }
 
-void writeCamera(const Camera& c, const std::string& path) {
-  std::ofstream out = openForWriting(path);
+std::string cameraText(const Camera& c) {
   const nlohmann::json j = {{"eye", c.eye}, {"target", c.target}, {"up", c.up}, {"fov_y_deg", c.fovYDeg}};
-  out << j.dump() << '\n';
+  return j.dump() + "\n";
 }
 
 }  // namespace
@@ -81,9 +83,9 @@ std::vector<std::string> writeObjScene(const Scene& scene, const std::string& ob
   std::vector<std::string> paths = {objPath, mtl};
   if (scene.hasCamera) paths.push_back(camera);
   for (const std::string& p : paths) checkOutputFile(p, force, "-o");
-  writeMtl(scene, mtl);
-  writeObj(scene, objPath, fs::path(mtl).filename().string());
-  if (scene.hasCamera) writeCamera(scene.camera, camera);
+  writeTextAtomically(mtl, "-o", mtlText(scene));
+  writeTextAtomically(objPath, "-o", objText(scene, fs::path(mtl).filename().string()));
+  if (scene.hasCamera) writeTextAtomically(camera, "-o", cameraText(scene.camera));
   return paths;
 }
 

@@ -1,0 +1,11 @@
+// Ctrl-C and kill during a render: the first SIGINT or SIGTERM asks the render to stop
+// (it keeps the passes finished so far, which are written); a second SIGINT exits at once.
+#pragma once
+#include <atomic>
+
+namespace fh {
+
+// Installs the handlers; returns the flag they set to the signal's number.
+const std::atomic<int>& installInterruptHandlers();
+
+}  // namespace fh
