@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # One command from a fresh Debian 12 machine to a result:
 #   ./setup.sh render [fredholm render options...]   build, then render (default: the Cornell box)
-#   ./setup.sh test                                  build, then run the whole test suite
+#   ./setup.sh test                                  build, run the whole test suite, then the
+#                                                    sanitizer builds and fuzzers (tests/sanitize.sh)
 #   ./setup.sh build                                 only install what is missing and build
 # Installs the Debian packages that are missing (needs root or sudo), configures and
 # builds into build/ (Release), and is quick when everything is already in place.
@@ -12,7 +13,8 @@ PACKAGES=(build-essential cmake ninja-build pkg-config
           pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers clinfo
           libopenimageio-dev openimageio-tools libtinyobjloader-dev libgtest-dev
           libcli11-dev nlohmann-json3-dev
-          clang oclgrind)  # the portability gates: offline compiles for other targets, a device simulator
+          clang oclgrind   # the portability gates: offline compiles for other targets, a device simulator
+          libclang-rt-14-dev)  # sanitizers and libFuzzer for clang (tests/sanitize.sh)
 # Optional: Embree for the bench comparison, matplotlib for the charts.
 OPTIONAL_PACKAGES=(libembree-dev python3-matplotlib)
 
@@ -53,6 +55,8 @@ case "$action" in
     # PoCL's kernel cache and fredholm's program cache live in the build tree for tests,
     # so a clean clone compiles each kernel once and reruns are fast.
     export POCL_CACHE_DIR="$PWD/build/pocl-cache" FREDHOLM_CACHE_DIR="$PWD/build/program-cache"
-    exec ctest --test-dir build --output-on-failure --timeout 900 "$@" ;;
+    ctest --test-dir build --output-on-failure --timeout 900 -j"$(nproc)" "$@"
+    # Then the sanitizer builds and the fuzzers (FREDHOLM_SANITIZERS=0 skips them locally).
+    [ "${FREDHOLM_SANITIZERS:-1}" = 0 ] || tests/sanitize.sh ;;
   *) echo "setup.sh: unknown action '$action' (use: build, render, test)" >&2; exit 2 ;;
 esac

@@ -19,7 +19,7 @@
 // Per-ray constants of the watertight test: the axis the ray is most aligned with
 // (kz), the shear that maps the ray onto +z, and the origin in that axis order.
 typedef struct {
-  float3 org;
+  float3 org_lo, org_hi;  // the origin as the slab test meets boxes' low and high faces
   float3 inv_dir;
   int kx, ky, kz;
   float sx, sy, sz;
@@ -30,7 +30,6 @@ FH_INLINE float component(float3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y
 
 FH_INLINE RayPrecomp precompute_ray(float3 org, float3 dir) {
   RayPrecomp r;
-  r.org = org;
   const float3 a = fabs(dir);
   r.kz = (a.x > a.y) ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
   r.kx = r.kz == 2 ? 0 : r.kz + 1;
@@ -48,13 +47,17 @@ FH_INLINE RayPrecomp precompute_ray(float3 org, float3 dir) {
   r.ox = component(org, r.kx);
   r.oy = component(org, r.ky);
   r.oz = component(org, r.kz);
-  // Zero direction components would give 0 * inf = NaN in the slab test; a tiny value
-  // keeps the reciprocal finite-signed and the test conservative.
+  // A zero direction component would give 0 * inf = NaN in the slab test. Such an axis
+  // gets a tiny positive direction instead, which alone would exit a box at t = 0 when the
+  // origin lies exactly on its high face (a ray along a wall's edge), so for that axis the
+  // origin is moved by a few ulps away from each face it is tested against: the slab
+  // becomes [lo - eps, hi + eps], conservative. Other axes are untouched.
   const float tiny = 1e-30f;
-  const float3 safe = (float3)(fabs(dir.x) < tiny ? copysign(tiny, dir.x) : dir.x,
-                               fabs(dir.y) < tiny ? copysign(tiny, dir.y) : dir.y,
-                               fabs(dir.z) < tiny ? copysign(tiny, dir.z) : dir.z);
-  r.inv_dir = 1.0f / safe;
+  const int3 flat = fabs(dir) < (float3)(tiny);
+  const float3 eps = fmax(fabs(org), (float3)(1.0f)) * 0x1p-20f;
+  r.inv_dir = 1.0f / select(dir, (float3)(tiny), flat);
+  r.org_lo = select(org, org + eps, flat);
+  r.org_hi = select(org, org - eps, flat);
   return r;
 }
 
@@ -111,11 +114,13 @@ FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8
 
 // Near distances of the eight children; lanes the ray misses get +INFINITY.
 FH_INLINE float8 intersect_children(const RayPrecomp* r, __global const Bvh8Node* node, float t_max) {
-  const float8 ox = (float8)(r->org.x), oy = (float8)(r->org.y), oz = (float8)(r->org.z);
   const float8 ix = (float8)(r->inv_dir.x), iy = (float8)(r->inv_dir.y), iz = (float8)(r->inv_dir.z);
-  const float8 tx0 = (vload8(0, node->lo_x) - ox) * ix, tx1 = (vload8(0, node->hi_x) - ox) * ix;
-  const float8 ty0 = (vload8(0, node->lo_y) - oy) * iy, ty1 = (vload8(0, node->hi_y) - oy) * iy;
-  const float8 tz0 = (vload8(0, node->lo_z) - oz) * iz, tz1 = (vload8(0, node->hi_z) - oz) * iz;
+  const float8 tx0 = (vload8(0, node->lo_x) - (float8)(r->org_lo.x)) * ix;
+  const float8 tx1 = (vload8(0, node->hi_x) - (float8)(r->org_hi.x)) * ix;
+  const float8 ty0 = (vload8(0, node->lo_y) - (float8)(r->org_lo.y)) * iy;
+  const float8 ty1 = (vload8(0, node->hi_y) - (float8)(r->org_hi.y)) * iy;
+  const float8 tz0 = (vload8(0, node->lo_z) - (float8)(r->org_lo.z)) * iz;
+  const float8 tz1 = (vload8(0, node->hi_z) - (float8)(r->org_hi.z)) * iz;
   const float8 t_near = fmax(fmax(fmin(tx0, tx1), fmin(ty0, ty1)), fmax(fmin(tz0, tz1), (float8)(0.0f)));
   const float8 t_far = fmin(fmin(fmax(tx0, tx1), fmax(ty0, ty1)), fmin(fmax(tz0, tz1), (float8)(t_max))) *
                        FH_SLAB_WIDEN;

@@ -52,12 +52,22 @@ TEST(Camera, BadCameraFilesNameTheProblem) {
     return std::string();
   };
   EXPECT_NE(message("{").find("invalid JSON"), std::string::npos);
+  // Found by fuzzing: a number beyond a double threw nlohmann's out_of_range, not an Error.
+  EXPECT_NE(message(R"({"eye": [1e3830,0,0], "target": [0,0,0], "fov_y_deg": 40})").find("invalid JSON"),
+            std::string::npos);
   EXPECT_NE(message(R"({"target": [0,0,0], "fov_y_deg": 40})").find("missing \"eye\""), std::string::npos);
   EXPECT_NE(message(R"({"eye": [0,0,1], "target": [0,0,0], "fov_y_deg": 200})").find("(0, 180)"),
             std::string::npos);
   EXPECT_NE(message(R"({"eye": [0,0,0], "target": [0,0,0], "fov_y_deg": 40})").find("coincide"), std::string::npos);
   EXPECT_NE(message(R"({"eye": [0,1,0], "target": [0,0,0], "up": [0,1,0], "fov_y_deg": 40})").find("parallel"),
             std::string::npos);
+  // Finite, but their difference overflows a float: the real reason, not "parallel" (issue 17, row 15).
+  EXPECT_NE(message(R"({"eye": [1e38,0,3], "target": [-1e38,0,0], "fov_y_deg": 40})").find("too far apart"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"eye": [1e20,0,0], "target": [0,0,0], "fov_y_deg": 40})").find("too far apart"),
+            std::string::npos);
+  // Far from the origin but close together is a valid camera.
+  EXPECT_EQ(message(R"({"eye": [1e30,0,1], "target": [1e30,0,0], "fov_y_deg": 40})"), "");
   EXPECT_THROW(loadCameraJson(dir + "/missing.json"), Error);
 }
 

@@ -375,6 +375,50 @@ TEST(Watertight, RaysAtSharedEdgesAndVerticesNeverMiss) {
   }
 }
 
+// Axis-aligned geometry and rays, as in a box scene seen straight on: the edge functions
+// of a ray through a shared edge or vertex are exactly zero, the case the watertight test
+// must count as inside for one triangle of every pair (issue 17: a one-sided `<=` there
+// passed every other test and left seams where walls meet). Each axis-aligned face of a
+// grid is hit through its vertices, edge midpoints and diagonals, from its front, along
+// each axis.
+TEST(Watertight, AxisAlignedRaysThroughEdgesAndVerticesOfAGridNeverMiss) {
+  test::SceneBuilder b;
+  const int m = b.material(0.5f), cells = 6;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int i = 0; i < cells; ++i)
+      for (int j = 0; j < cells; ++j) {
+        // A cell of the plane {axis} = 0, its front toward +{axis}, offset along the axis
+        // per plane so the three grids do not overlap.
+        auto at = [&](float u, float v) {
+          float3 p{};
+          p[size_t(axis)] = 10.f * float(axis);
+          p[size_t((axis + 1) % 3)] = u;
+          p[size_t((axis + 2) % 3)] = v;
+          return p;
+        };
+        float3 toward = at(float(i) + 0.5f, float(j) + 0.5f);
+        toward[size_t(axis)] += 1.f;
+        b.quadFacing(at(float(i), float(j)), at(float(i + 1), float(j)), at(float(i + 1), float(j + 1)),
+                     at(float(i), float(j + 1)), toward, m);
+      }
+  const Scene grid = b.build();
+  RayCasting rc(grid);
+  Rays rays;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int i = 0; i <= 2 * cells; ++i)
+      for (int j = 0; j <= 2 * cells; ++j) {
+        // Half-integer steps: vertices, edge midpoints, cell centres (on a diagonal).
+        float3 o{}, d{};
+        o[size_t(axis)] = 10.f * float(axis) + 2.f;
+        o[size_t((axis + 1) % 3)] = 0.5f * float(i);
+        o[size_t((axis + 2) % 3)] = 0.5f * float(j);
+        d[size_t(axis)] = -1.f;
+        rays.add(o, d);
+      }
+  rc.expectMatchesReference(rays, "axis-aligned grid");
+  EXPECT_EQ(rc.lastHitFraction, 1.0) << "axis-aligned rays through shared edges or vertices missed";
+}
+
 // Triangles at exactly the current hit's distance in a later leaf (duplicated faces, as in
 // the archive's Cornell box, or overlapping ones) must leave the hit and its barycentrics
 // as they were: a lane that passes the division-free interval test but whose quotient t

@@ -12,10 +12,13 @@
 //   better method.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
+#include <vector>
 #include <nlohmann/json.hpp>
 
+#include "render/pixel_filter.h"
 #include "render/render.h"
 #include "scene/closed_form.h"
 #include "scene_builder.h"
@@ -290,6 +293,51 @@ TEST(PathTracer, NoNonFiniteSamplesOnAnySharedScene) {
       EXPECT_EQ(r.stats.nonfinite, 0u) << path << " " << methodName(m);
       for (float v : r.film.image().rgb) ASSERT_TRUE(std::isfinite(v)) << path;
     }
+  }
+}
+
+// The pixel filters' importance sampling: offsets drawn through each tabulated inverse CDF
+// (interpolated as kernels/film.h does) follow the filter's own shape, written out here
+// independently (issue 17: a Gaussian sampled as a box passed every test).
+TEST(PixelFilters, ImportanceSamplesFollowEachFiltersShape) {
+  struct Shape {
+    PixelFilter filter;
+    double radius;
+    std::function<double(double)> weight;
+  };
+  const double pi = 3.14159265358979323846;
+  const Shape shapes[] = {
+      {PixelFilter::Box, 0.5, [](double) { return 1.0; }},
+      {PixelFilter::Gaussian, 1.5, [](double x) { return std::exp(-2.0 * x * x) - std::exp(-2.0 * 1.5 * 1.5); }},
+      {PixelFilter::BlackmanHarris, 2.0,
+       [&](double x) {
+         const double t = (x + 2.0) / 4.0;
+         return 0.35875 - 0.48829 * std::cos(2 * pi * t) + 0.14128 * std::cos(4 * pi * t) -
+                0.01168 * std::cos(6 * pi * t);
+       }},
+  };
+  for (const Shape& shape : shapes) {
+    float radius = 0.f;
+    const std::vector<float> table = filterInverseCdf(shape.filter, 256, &radius);
+    EXPECT_FLOAT_EQ(radius, float(shape.radius)) << filterName(shape.filter);
+    const int bins = 24, draws = 240000;
+    std::vector<double> histogram(bins, 0.0), expected(bins, 0.0);
+    for (int i = 0; i < draws; ++i) {
+      const double u = (i + 0.5) / draws, x = u * double(table.size() - 1);
+      const size_t k = std::min(size_t(x), table.size() - 2);
+      const double offset = table[k] + (table[k + 1] - table[k]) * (x - double(k));
+      const int bin = int((offset + shape.radius) / (2 * shape.radius) * bins);
+      histogram[size_t(std::clamp(bin, 0, bins - 1))] += 1.0 / draws;
+    }
+    double total = 0;
+    for (int b = 0; b < bins; ++b)
+      for (int j = 0; j < 100; ++j) {  // midpoint rule within the bin
+        const double x = -shape.radius + 2 * shape.radius * (b + (j + 0.5) / 100.0) / bins;
+        expected[size_t(b)] += shape.weight(x);
+        total += shape.weight(x);
+      }
+    for (int b = 0; b < bins; ++b)
+      EXPECT_NEAR(histogram[size_t(b)], expected[size_t(b)] / total, 2e-3) << filterName(shape.filter) << " bin " << b;
   }
 }
 

@@ -65,6 +65,27 @@ TEST_F(PixelSamplerOnDevice, EveryPowerOfTwoPrefixIsANet) {
   }
 }
 
+// A pixel's first two samples lie in opposite halves of every dimension (the net), but
+// where in each half is random: their difference, across pixels, is spread out. Sobol'
+// points with the index shuffled but the values not scrambled (issue 17: unbiased, so no
+// other test saw it) put every pixel's second sample exactly half a unit from its first.
+TEST_F(PixelSamplerOnDevice, APixelsFirstTwoSamplesAreNotAFixedDistanceApart) {
+  const unsigned pixels = 16384;
+  for (bool oneD : {false, true}) {
+    const std::vector<float> v = draw(11, pixels, 2, 6, oneD);
+    for (int axis = 0; axis < (oneD ? 1 : 2); ++axis) {
+      size_t nearHalf = 0;
+      for (unsigned p = 0; p < pixels; ++p) {
+        const double d = std::fabs(double(v[2 * (size_t(pixels) + p) + size_t(axis)]) - v[2 * size_t(p) + size_t(axis)]);
+        nearHalf += std::fabs(d - 0.5) < 1.0 / 256;
+      }
+      // The difference of two uniform points in the two halves has density 2 at 1/2: about
+      // 1.6 % of pixels fall within 1/256 of it.
+      EXPECT_LT(double(nearHalf) / pixels, 0.05) << (oneD ? "1D" : "2D") << " axis " << axis;
+    }
+  }
+}
+
 // Each sample index, over many pixels, is uniform in the square: the scrambling is random
 // per pixel, which is what keeps the estimator unbiased.
 TEST_F(PixelSamplerOnDevice, EachSampleIsUniformAcrossPixels) {

@@ -265,6 +265,21 @@ TEST_F(BadInput, FilesThatAreNotRegularFiles) {
   EXPECT_TRUE(scene.textures.empty());
 }
 
+// Only the materials the OBJ uses are kept: memory follows the scene, not the library
+// (issue 17, row 14: a million unused materials cost 2.2 GB).
+TEST_F(BadInput, UnusedMaterialsAreNotKept) {
+  std::string mtl = "# a big library\n";
+  for (int i = 0; i < 20000; ++i) mtl += "newmtl m" + std::to_string(i) + "\nKd 0.5 0.5 0.5\n";
+  mtl += "newmtl light\nKe 1 1 1\n";
+  writeFile(path("big.mtl"), mtl);
+  writeFile(path("big.obj"), "mtllib big.mtl\n" + std::string(kTriangle) + "usemtl m17\nf 1 2 3\nusemtl light\nf 3 2 1\n");
+  const Scene scene = loadScene(path("big.obj"));
+  ASSERT_EQ(scene.materials.size(), 3u);  // m17, light and the default grey
+  EXPECT_EQ(scene.materials[size_t(scene.triangleMaterial[0])].name, "m17");
+  EXPECT_EQ(scene.materials[size_t(scene.triangleMaterial[1])].name, "light");
+  EXPECT_EQ(scene.lights.size(), 1u);
+}
+
 TEST_F(BadInput, MissingMtl) {
   EXPECT_NE(errorFor(std::string("mtllib gone.mtl\n") + kTriangle + "f 1 2 3\n")
                 .find("scene.obj:1: material library 'gone.mtl' not found"),

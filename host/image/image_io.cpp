@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -50,6 +51,13 @@ Image readPfm(const std::string& path) {
       image.height <= 0 || scale >= 0.0 || image.width > (1 << 16) || image.height > (1 << 16))
     throw Error("cannot read '" + path + "': not a little-endian RGB PFM file");
   in.get();  // the single whitespace byte before the pixels
+  // The pixels must be in the file before they are allocated (a header can claim 4G pixels).
+  const auto start = in.tellg();
+  in.seekg(0, std::ios::end);
+  const auto bytes = static_cast<long long>(in.tellg() - start);
+  in.seekg(start);
+  if (bytes < static_cast<long long>(image.width) * image.height * 12)
+    throw Error("cannot read '" + path + "': file ends early");
   image.rgb.resize(size_t(image.width) * size_t(image.height) * 3);
   for (int y = image.height - 1; y >= 0; --y)
     in.read(reinterpret_cast<char*>(&image.rgb[size_t(y) * size_t(image.width) * 3]),
@@ -183,6 +191,16 @@ Image readImage(const std::string& path) {
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw Error("cannot read '" + path + "': " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
+  // As many pixels as fredholm renders at most, and no more than the file can hold: no
+  // format fredholm writes compresses a pixel below a thousandth of a byte, and a header
+  // claiming more would have the reader allocate and decode gigabytes of nothing.
+  std::error_code ec;
+  const uint64_t fileBytes = uint64_t(fs::file_size(path, ec)), count = uint64_t(spec.width) * uint64_t(spec.height);
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.nchannels > 64 ||
+      count > (uint64_t(1) << 28) || count > 1024 * fileBytes + 65536)
+    throw Error("cannot read '" + path + "': " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                "x" + std::to_string(spec.nchannels) + " is not an image fredholm compares (" +
+                std::to_string(fileBytes) + " bytes)");
   Image image;
   image.width = spec.width;
   image.height = spec.height;

@@ -21,10 +21,12 @@ void DeviceWorker::run(const RenderSettings& settings) {
 
 // New passes while fewer than passSlots() are unfinished (and this device has room for them).
 void DeviceWorker::takePasses() {
+  const uint64_t before = granted_;
   uint32_t pass;
   while (granted_ - returned_ < pipeline_.passSlots() && granted_ < pipeline_.passCapacity() &&
          source_.take(index_, pass))
     pipeline_.grantPass(granted_++, pass);
+  if (granted_ != before) pipeline_.startGrantedPasses(granted_);
 }
 
 // Every complete pass, in local order (a pass's slot is reused only after it is returned).

@@ -175,10 +175,14 @@ void WavefrontPipeline::writeCounter(size_t offset, const uint32_t& value) {
 }
 
 void WavefrontPipeline::grantPass(uint64_t local, uint32_t global) {
-  passTable_[local] = global;
+  passTable_[local] = global;  // stable storage: the write is asynchronous
   FH_CL(dc_.queue.enqueueWriteBuffer(passTableBuffer_, CL_FALSE, local * 4, 4, &passTable_[local]));
-  // The pass may start once the limit covers it. Stable storage: the write is asynchronous.
-  sampleLimit_ = uint32_t((local + 1) * pixels_);
+}
+
+void WavefrontPipeline::startGrantedPasses(uint64_t granted) {
+  // sampleLimit_ is the source of an asynchronous write: it is set once per batch, after the
+  // previous batch's write has completed (readCounters waits for the queue).
+  sampleLimit_ = uint32_t(granted * pixels_);
   writeCounter(offsetof(gpu::WavefrontCounters, sample_limit), sampleLimit_);
 }
 

@@ -62,6 +62,8 @@ class WavefrontPipeline {
   unsigned passSlots() const { return passSlots_; }
   uint64_t passCapacity() const { return passTable_.size(); }
   void grantPass(uint64_t local, uint32_t global);
+  // Lets local passes 0 .. granted-1 start; once per batch, after its grants.
+  void startGrantedPasses(uint64_t granted);
   uint32_t globalPass(uint64_t local) const { return passTable_[local]; }
 
   // Waits for the queued iterations and reads the books back.

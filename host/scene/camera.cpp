@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -12,12 +13,22 @@
 namespace fh {
 namespace {
 
+// A JSON number as a float; beyond float's range is an error (the cast would be undefined).
+float toFloat(const nlohmann::json& number, const std::string& path, const std::string& key) {
+  const double v = number.get<double>();
+  if (!(std::fabs(v) <= double(std::numeric_limits<float>::max())))
+    throw Error(path + ": camera \"" + key + "\" holds a number beyond single precision");
+  return float(v);
+}
+
 std::array<float, 3> readVec3(const nlohmann::json& j, const char* key, const std::string& path) {
   if (!j.contains(key)) throw Error(path + ": camera is missing \"" + key + "\"");
   const auto& v = j.at(key);
   if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() || !v[2].is_number())
     throw Error(path + ": camera \"" + key + "\" must be an array of three numbers");
-  return {v[0].get<float>(), v[1].get<float>(), v[2].get<float>()};
+  std::array<float, 3> out{};
+  for (size_t k = 0; k < 3; ++k) out[k] = toFloat(v[k], path, key);
+  return out;
 }
 
 }  // namespace
@@ -34,7 +45,7 @@ Camera parseCameraJson(const std::string& text, const std::string& path) {
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // a syntax error, or a number that overflows a double
     throw Error(path + ": invalid JSON (" + e.what() + ")");
   }
   if (!j.is_object()) throw Error(path + ": camera file must hold a JSON object");
@@ -44,7 +55,7 @@ Camera parseCameraJson(const std::string& text, const std::string& path) {
   c.up = j.contains("up") ? readVec3(j, "up", path) : std::array<float, 3>{0.f, 1.f, 0.f};
   if (!j.contains("fov_y_deg") || !j["fov_y_deg"].is_number())
     throw Error(path + ": camera needs a number \"fov_y_deg\"");
-  c.fovYDeg = j["fov_y_deg"].get<float>();
+  c.fovYDeg = toFloat(j["fov_y_deg"], path, "fov_y_deg");
   validateCamera(c, path);
   return c;
 }
@@ -54,10 +65,17 @@ void validateCamera(const Camera& c, const std::string& source) {
     throw Error(source + ": camera values must be finite");
   if (!(c.fovYDeg > 0.f && c.fovYDeg < 180.f))
     throw Error(source + ": vertical field of view must lie in (0, 180) degrees");
-  const float3 forward = c.target - c.eye;
-  if (length(forward) == 0.f) throw Error(source + ": camera eye and target coincide");
-  if (length(cross(normalize(forward), c.up)) < 1e-6f)
-    throw Error(source + ": camera up vector is parallel to the view direction");
+  // In double first: in float, (target - eye) or its squared length may overflow, which
+  // would show up below as a misleading "parallel" or "coincide".
+  double distance2 = 0.0;
+  for (size_t k = 0; k < 3; ++k) distance2 += std::pow(double(c.target[k]) - double(c.eye[k]), 2);
+  if (distance2 == 0.0) throw Error(source + ": camera eye and target coincide");
+  const CameraFrame frame = makeCameraFrame(c, 1, 1);
+  if (!isFinite(frame.forward) || !(std::fabs(length(frame.forward) - 1.f) < 1e-3f))
+    throw Error(source + ": camera eye and target are too far apart (" + std::to_string(std::sqrt(distance2)) +
+                ") for single precision");
+  if (!isFinite(frame.right) || length(cross(frame.forward, c.up)) < 1e-6f)
+    throw Error(source + ": camera up vector is parallel to the view direction (or too large)");
 }
 
 Camera frameBounds(const std::array<float, 3>& lo, const std::array<float, 3>& hi, float fovYDeg) {

@@ -85,6 +85,30 @@ Material toMaterial(const tinyobj::material_t& m) {
   return out;
 }
 
+// The MTL text with only the materials the OBJ uses (and what precedes the first newmtl):
+// tinyobjloader keeps about 2 KB per material it reads, so a library of a million materials
+// for a few faces would cost gigabytes. Names are read as the lint reads them.
+std::string keepUsedMaterials(const std::string& mtl, const std::set<std::string>& used) {
+  std::string kept;
+  bool keeping = true;
+  size_t start = 0;
+  while (start < mtl.size()) {
+    size_t end = mtl.find('\n', start);
+    end = end == std::string::npos ? mtl.size() : end + 1;
+    const std::string line = mtl.substr(start, end - start);
+    const size_t first = line.find_first_not_of(" \t");
+    if (first != std::string::npos && line.compare(first, 6, "newmtl") == 0 &&
+        (first + 6 == line.size() || line[first + 6] == ' ' || line[first + 6] == '\t')) {
+      const size_t nameStart = line.find_first_not_of(" \t", first + 6);
+      const size_t nameEnd = nameStart == std::string::npos ? nameStart : line.find_first_of(" \t\r\n#", nameStart);
+      keeping = nameStart != std::string::npos && used.count(line.substr(nameStart, nameEnd - nameStart)) > 0;
+    }
+    if (keeping) kept += line;
+    start = end;
+  }
+  return kept;
+}
+
 struct SceneText {
   std::string objName;
   std::string obj;
@@ -259,6 +283,8 @@ Scene loadScene(const std::string& objPath) {
   text.baseDir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
 
   const ObjLintReport report = lintObj(text.obj, objPath);
+  std::set<std::string> used;
+  for (const auto& use : report.usemtls) used.insert(use.argument);
   for (const auto& lib : report.mtllibs) {
     const fs::path mtlPath = resolveCaseInsensitive(text.baseDir, lib.argument);
     if (mtlPath.empty())
@@ -267,7 +293,7 @@ Scene loadScene(const std::string& objPath) {
     const std::string mtl = readTextFile(mtlPath, "MTL file");
     // An empty library is legal: buildScene warns about every material it lacks.
     lintMtl(mtl, mtlPath.string());
-    text.mtl += mtl + "\n";
+    text.mtl += keepUsedMaterials(mtl, used) + "\n";
   }
   Scene scene = buildScene(text, report);
 

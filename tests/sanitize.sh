@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# The sanitizer part of `./setup.sh test` (and so of CI), after the main suite:
+#  1. an AddressSanitizer + UndefinedBehaviorSanitizer build (clang) that runs the fast
+#     suites (ctest -L fast) and each libFuzzer target for FUZZ_SECONDS over a copy of the
+#     seed corpus, failing on any crash, hang (> 2 s per input) or memory blow-up;
+#  2. a ThreadSanitizer build that runs the multi-device suites (several devices, a device
+#     failing mid-render).
+# Build trees: build-asan/ and build-tsan/. FUZZ_SECONDS (default 60) sets the fuzzing time.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+fuzz_seconds=${FUZZ_SECONDS:-60}
+
+configure() {  # DIR SANITIZERS [extra cmake args]
+  local dir=$1 sanitizers=$2
+  shift 2
+  local generator=()
+  [ -f "$dir/CMakeCache.txt" ] || generator=(-G Ninja)
+  cmake -S . -B "$dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+    -DFREDHOLM_SANITIZE="$sanitizers" -DFREDHOLM_WITH_EMBREE=OFF "$@" >/dev/null
+}
+
+# PoCL and its LLVM are not built with the sanitizers: leaks inside them are not ours.
+export ASAN_OPTIONS=detect_leaks=0:abort_on_error=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+export TSAN_OPTIONS="suppressions=$PWD/tests/tsan.supp:halt_on_error=1:second_deadlock_stack=1"
+start=$SECONDS
+
+echo "sanitize: AddressSanitizer + UndefinedBehaviorSanitizer, fast suites and fuzzing" >&2
+configure build-asan address,undefined -DFREDHOLM_FUZZ=ON
+cmake --build build-asan --parallel "$(nproc)"
+POCL_CACHE_DIR="$PWD/build-asan/pocl-cache" FREDHOLM_CACHE_DIR="$PWD/build-asan/program-cache" \
+  ctest --test-dir build-asan -L fast --output-on-failure --timeout 900 -j"$(nproc)"
+
+for target in scene_loader camera_json image_read; do
+  corpus_name=${target%%_*}
+  [ "$target" = camera_json ] && corpus_name=camera
+  [ "$target" = image_read ] && corpus_name=image
+  work=$(mktemp -d)
+  cp -r "tests/fuzz/corpus/$corpus_name/." "$work/"
+  echo "sanitize: fuzzing $target for ${fuzz_seconds}s" >&2
+  # -timeout: an input taking over 2 s is a hang; -rss_limit_mb: memory blow-up.
+  ASAN_OPTIONS="$ASAN_OPTIONS:quarantine_size_mb=64" \
+  "build-asan/tests/fuzz/fuzz_$target" -max_total_time="$fuzz_seconds" -timeout=2 -rss_limit_mb=2560 \
+    -print_final_stats=1 -artifact_prefix="build-asan/fuzz-$target-" "$work" 2>&1 | tail -n 12 >&2
+  rm -rf "$work"
+done
+
+echo "sanitize: ThreadSanitizer, multi-device suites" >&2
+configure build-tsan thread
+cmake --build build-tsan --parallel "$(nproc)" --target fredholm test_multi_device
+POCL_CACHE_DIR="$PWD/build-tsan/pocl-cache" FREDHOLM_CACHE_DIR="$PWD/build-tsan/program-cache" \
+  ctest --test-dir build-tsan -R "TwoDevices|MultiDeviceCli" --output-on-failure --timeout 900
+echo "sanitize: done in $((SECONDS - start)) s" >&2
