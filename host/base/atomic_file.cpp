@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -17,12 +18,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// .NAME.fredholm-tmp-PID.EXT beside the target: hidden, unique per process, and with the
-// target's extension, which image writers choose their format by.
+// .NAME.fredholm-tmp-PID-N.EXT beside the target: hidden, unique per process and call (two
+// devices may store the same program at once), and with the target's extension, which image
+// writers choose their format by.
 std::string temporaryBeside(const std::string& path) {
+  static std::atomic<unsigned> calls{0};
   const fs::path p(path);
-  const std::string name = "." + p.stem().string() + ".fredholm-tmp-" + std::to_string(::getpid()) +
-                           p.extension().string();
+  const std::string name = "." + p.stem().string() + ".fredholm-tmp-" + std::to_string(::getpid()) + "-" +
+                           std::to_string(calls++) + p.extension().string();
   return (p.parent_path() / name).string();
 }
 

@@ -1,6 +1,8 @@
 // Program assembly, build with build-log reporting, and the binary cache.
 #include "device/program.h"
 
+#include "base/atomic_file.h"
+
 #include <chrono>
 #include <cstdint>
 #include <cstdlib>
@@ -131,15 +133,11 @@ void storeCached(const cl::Program& program, const std::string& path) {
   std::error_code ec;
   fs::create_directories(fs::path(path).parent_path(), ec);
   if (ec) return;  // an unwritable cache only costs a recompile next time
-  const std::string tmp = path + ".tmp" + std::to_string(std::rand());
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) return;
-    out.write(reinterpret_cast<const char*>(binaries[0].data()), std::streamsize(binaries[0].size()));
-    if (!out) return;
+  try {  // whole or not at all, like every file fredholm writes
+    writeTextAtomically(path, "program cache",
+                        std::string(reinterpret_cast<const char*>(binaries[0].data()), binaries[0].size()));
+  } catch (const Error&) {
   }
-  fs::rename(tmp, path, ec);
-  if (ec) fs::remove(tmp, ec);
 }
 
 }  // namespace
