@@ -231,4 +231,28 @@ std::vector<std::string> lintMtl(const std::string& text, const std::string& nam
   return materials;
 }
 
+// The MTL text with only the materials the OBJ uses (and what precedes the first newmtl):
+// tinyobjloader keeps about 2 KB per material it reads, so a library of a million materials
+// for a few faces would cost gigabytes. Names are read as the lint reads them.
+std::string keepUsedMaterials(const std::string& mtl, const std::set<std::string>& used) {
+  std::string kept;
+  bool keeping = true;
+  size_t start = 0;
+  while (start < mtl.size()) {
+    size_t end = mtl.find('\n', start);
+    end = end == std::string::npos ? mtl.size() : end + 1;
+    const std::string line = mtl.substr(start, end - start);
+    const size_t first = line.find_first_not_of(" \t");
+    if (first != std::string::npos && line.compare(first, 6, "newmtl") == 0 &&
+        (first + 6 == line.size() || line[first + 6] == ' ' || line[first + 6] == '\t')) {
+      const size_t nameStart = line.find_first_not_of(" \t", first + 6);
+      const size_t nameEnd = nameStart == std::string::npos ? nameStart : line.find_first_of(" \t\r\n#", nameStart);
+      keeping = nameStart != std::string::npos && used.count(line.substr(nameStart, nameEnd - nameStart)) > 0;
+    }
+    if (keeping) kept += line;
+    start = end;
+  }
+  return kept;
+}
+
 }  // namespace fh

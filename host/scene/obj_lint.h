@@ -2,6 +2,7 @@
 // skips or zero-fills what it cannot read and rarely says where; these checks turn bad
 // input into an fh::Error naming "file:line" so a scene never loads silently wrong.
 #pragma once
+#include <set>
 #include <string>
 #include <vector>
 
@@ -28,5 +29,9 @@ ObjLintReport lintObj(const std::string& text, const std::string& name);
 // without a name, and colour or scalar fields that are not finite numbers.
 // Returns the names of the materials it defines.
 std::vector<std::string> lintMtl(const std::string& text, const std::string& name);
+
+// The MTL text with only the materials in `used` (and what precedes the first newmtl),
+// names read as the lint reads them (see obj_lint.cpp).
+std::string keepUsedMaterials(const std::string& mtl, const std::set<std::string>& used);
 
 }  // namespace fh
