@@ -53,8 +53,7 @@ TEST(RenderCli, StatsAndExrMetadata) {
   const auto r = test::runFredholm("render --width 16 --height 12 --spp 3 --method nee --seed 7 -o " + dir +
                                    "/a.exr --stats " + dir + "/s.json");
   ASSERT_EQ(r.exitCode, 0) << r.output;
-  std::ifstream in(dir + "/s.json");
-  const auto stats = nlohmann::json::parse(in);
+  const auto stats = test::readJson(dir + "/s.json");
   EXPECT_EQ(stats["samples"], 16 * 12 * 3);
   EXPECT_EQ(stats["nonfinite_samples"], 0);
   EXPECT_GT(stats["samples_per_second"].get<double>(), 0.0);
@@ -80,8 +79,7 @@ TEST(RenderCli, TimeBudgetEndsOnWholePasses) {
   const auto r = test::runFredholm("render --width 32 --height 32 --time 1 -o " + dir + "/t.exr --stats " + dir +
                                    "/s.json");
   ASSERT_EQ(r.exitCode, 0) << r.output;
-  std::ifstream in(dir + "/s.json");
-  const auto stats = nlohmann::json::parse(in);
+  const auto stats = test::readJson(dir + "/s.json");
   const uint64_t samples = stats["samples"];
   EXPECT_GT(samples, 0u);
   EXPECT_EQ(samples % (32 * 32), 0u);           // every pixel has the same sample count
@@ -162,8 +160,7 @@ TEST(RenderCli, WavefrontIsCappedAtWhatTheImageCanUse) {
   const auto r = test::runFredholm("render --width 16 --height 16 --spp 4 --wavefront 100000000 -o " + dir +
                                    "/w.pfm --stats " + dir + "/s.json");
   ASSERT_EQ(r.exitCode, 0) << r.output;
-  std::ifstream in(dir + "/s.json");
-  const auto stats = nlohmann::json::parse(in);
+  const auto stats = test::readJson(dir + "/s.json");
   EXPECT_LE(stats["wavefront"].get<size_t>(), 8u * 16u * 16u);
   EXPECT_EQ(stats["samples"], 16 * 16 * 4);
 }

@@ -133,8 +133,7 @@ TEST(MultiDeviceCli, UnequalPairBothWorkAndStatsReportShares) {
                                        "/m.exr --stats " + dir + "/s.json",
                                    env);
   ASSERT_EQ(r.exitCode, 0) << r.output;
-  std::ifstream in(dir + "/s.json");
-  const auto stats = nlohmann::json::parse(in);
+  const auto stats = test::readJson(dir + "/s.json");
   ASSERT_EQ(stats["devices"].size(), 2u);
   double shares = 0;
   for (const auto& d : stats["devices"]) {
@@ -168,8 +167,7 @@ TEST(MultiDeviceCli, EveryCommandTakesEveryDeviceTheSpecSelects) {
   auto image = OIIO::ImageInput::open(dir + "/m.exr");
   ASSERT_TRUE(image);
   const std::string named = image->spec().get_string_attribute("fredholm:device");
-  std::ifstream statsFile(dir + "/s.json");
-  const auto stats = nlohmann::json::parse(statsFile);
+  const auto stats = test::readJson(dir + "/s.json");
   ASSERT_EQ(stats["devices"].size(), 2u);
   for (const auto& d : stats["devices"]) {
     const std::string name = d["name"];
@@ -180,8 +178,7 @@ TEST(MultiDeviceCli, EveryCommandTakesEveryDeviceTheSpecSelects) {
   const auto bench = test::runFredholm(
       "bench cornell --device all --width 16 --height 16 --repeats 1 --json " + dir + "/b.json", env);
   ASSERT_EQ(bench.exitCode, 0) << bench.output;
-  std::ifstream benchFile(dir + "/b.json");
-  const auto doc = nlohmann::json::parse(benchFile);
+  const auto doc = test::readJson(dir + "/b.json");
   ASSERT_EQ(doc["devices"].size(), 2u);
   for (const auto& device : doc["devices"]) {
     int rows = 0;

@@ -215,8 +215,7 @@ TEST(GpuScript, RunsEndToEndOnPoclWithSmallSizes) {
   const test::CommandResult r = test::runCommand(std::string(FREDHOLM_SOURCE_DIR) + "/bench/gpu/run_gpu.sh --small " +
                                                  FREDHOLM_BINARY + " " + out);
   ASSERT_EQ(r.exitCode, 0) << r.output;
-  std::ifstream in(out + "/results.json");
-  const auto results = nlohmann::json::parse(in);
+  const auto results = test::readJson(out + "/results.json");
   EXPECT_GT(results["cornell_mis"]["msamples_per_s"].get<double>(), 0.0) << results;
   EXPECT_GT(results["best_wavefront"].get<double>(), 0.0) << results;
   const double ratio = results["cornell_mis"]["cpu"]["relmse_ratio_to_two_gpu_seeds"].get<double>();

@@ -54,6 +54,11 @@ void writeFile(const std::string& path, const std::string& text) {
   out << text;
 }
 
+nlohmann::json readJson(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
 CommandResult runFredholm(const std::string& args, const std::string& env) {
   return runCommand(env + " " + FREDHOLM_BINARY + " " + args);
 }

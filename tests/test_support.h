@@ -3,6 +3,8 @@
 #include <cmath>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 namespace fh::test {
 
 // Absolute path of a file in ../shared/scenes, or "" if the corpus is absent.
@@ -21,6 +23,8 @@ struct CommandResult {
 };
 // Runs a shell command line, stdout and stderr together.
 CommandResult runCommand(const std::string& command);
+// The JSON file at `path` (a --stats or --json output); an unreadable file fails the parse.
+nlohmann::json readJson(const std::string& path);
 // Runs the fredholm binary with `args` (a shell-quoted string) and optional environment prefix.
 CommandResult runFredholm(const std::string& args, const std::string& env = "");
 

@@ -90,14 +90,14 @@ RenderSettings settingsFrom(const RenderOptions& o) {
 }
 
 // --aov: first-hit albedo, normal or depth, on one device (runRender checks there is one).
-RenderResult renderDebugView(const RenderOptions& o, const std::vector<DeviceInfo>& devices, const Scene& scene,
+RenderResult renderDebugView(Aov mode, const std::vector<DeviceInfo>& devices, const Scene& scene,
                              const Bvh& bvh, const Camera& camera, const RenderSettings& s) {
   AovSettings a;
   a.width = s.width;
   a.height = s.height;
   a.spp = s.spp;
   a.seed = s.seed;
-  a.mode = parseAov(o.aov);
+  a.mode = mode;
   DeviceContext dc(devices[0]);
   const Image image = renderAov(dc, scene, bvh, camera, a);
   RenderResult r;
@@ -127,7 +127,8 @@ void reportDevices(const RenderResult& r) {
 int runRender(RenderOptions o) {
   RenderSettings settings = settingsFrom(o);
   settings.stop = &installInterruptHandlers();
-  if (!o.aov.empty()) parseAov(o.aov);
+  const bool debugView = !o.aov.empty();
+  const Aov aov = debugView ? parseAov(o.aov) : Aov::Albedo;
   // An explicit -o is never overwritten without --force; the default name steps aside.
   if (o.output.empty()) o.output = firstFreeName("fredholm.png");
   checkOutputPath(o.output, o.force);
@@ -143,8 +144,7 @@ int runRender(RenderOptions o) {
   const Camera camera = chooseCamera(o, scene);
   const auto start = std::chrono::steady_clock::now();
   const Bvh bvh = buildBvh(scene);
-  const bool debugView = !o.aov.empty();
-  const RenderResult r = debugView ? renderDebugView(o, devices, scene, bvh, camera, settings)
+  const RenderResult r = debugView ? renderDebugView(aov, devices, scene, bvh, camera, settings)
                                    : render(devices, scene, bvh, camera, settings);
   const std::string method = debugView ? "aov:" + o.aov : methodName(settings.method);
   reportDevices(r);

@@ -34,6 +34,20 @@ void requirePlainText(const std::string& text, const std::string& name) {
   }
 }
 
+// One line's tokens, split at spaces and tabs, with a final CR and any comment removed.
+std::vector<std::string> tokensOf(std::string line) {
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
+  std::vector<std::string> tokens;
+  size_t start = 0;
+  while ((start = line.find_first_not_of(" \t", start)) != std::string::npos) {
+    const size_t end = line.find_first_of(" \t", start);
+    tokens.push_back(line.substr(start, end == std::string::npos ? std::string::npos : end - start));
+    start = end;
+  }
+  return tokens;
+}
+
 struct LineReader {
   std::istringstream in;
   std::string name;
@@ -48,15 +62,7 @@ struct LineReader {
     std::string line;
     if (!std::getline(in, line)) return false;
     ++number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
-    tokens.clear();
-    size_t start = 0;
-    while ((start = line.find_first_not_of(" \t", start)) != std::string::npos) {
-      const size_t end = line.find_first_of(" \t", start);
-      tokens.push_back(line.substr(start, end == std::string::npos ? std::string::npos : end - start));
-      start = end;
-    }
+    tokens = tokensOf(line);
     return true;
   }
 
@@ -242,13 +248,8 @@ std::string keepUsedMaterials(const std::string& mtl, const std::set<std::string
     size_t end = mtl.find('\n', start);
     end = end == std::string::npos ? mtl.size() : end + 1;
     const std::string line = mtl.substr(start, end - start);
-    const size_t first = line.find_first_not_of(" \t");
-    if (first != std::string::npos && line.compare(first, 6, "newmtl") == 0 &&
-        (first + 6 == line.size() || line[first + 6] == ' ' || line[first + 6] == '\t')) {
-      const size_t nameStart = line.find_first_not_of(" \t", first + 6);
-      const size_t nameEnd = nameStart == std::string::npos ? nameStart : line.find_first_of(" \t\r\n#", nameStart);
-      keeping = nameStart != std::string::npos && used.count(line.substr(nameStart, nameEnd - nameStart)) > 0;
-    }
+    const std::vector<std::string> t = tokensOf(line.substr(0, line.size() - (line.back() == '\n')));
+    if (!t.empty() && t[0] == "newmtl") keeping = t.size() > 1 && used.count(t[1]) > 0;
     if (keeping) kept += line;
     start = end;
   }
