@@ -3,27 +3,33 @@
 // a pass back once all its pixels are in and merges passes into the film in pass order,
 // which keeps the image deterministic for a seed whatever order paths finish in. Up to
 // FH_PASS_SLOTS passes are in flight, so the wavefront stays full while a pass's last,
-// longest paths finish.
+// longest paths finish. FH_LANES paths per work-item (lanes.h).
 #include "path_state.h"
+#include "lanes.h"
 
 __kernel void accumulate(__global const uint* finished_queue, volatile __global WavefrontCounters* counters,
                          __global uint* free_list, uint pixel_count, __global float4* pass_buffer FH_PATH_PARAMS) {
   volatile __local uint finished_in_slot[FH_PASS_SLOTS];
-  const uint i = get_global_id(0), lid = get_local_id(0);
+  const uint lid = get_local_id(0);
   if (lid < FH_PASS_SLOTS) finished_in_slot[lid] = 0;
   barrier(CLK_LOCAL_MEM_FENCE);
-  if (i < counters->finished_length) {
-    const uint p = finished_queue[i];
-    const uint pixel = sample_id[p] % pixel_count, slot = local_pass[p] % FH_PASS_SLOTS;
-    float3 value = radiance[p].xyz;
-    if (!all(isfinite(value))) {
+  const luint position = lane_positions(get_global_id(0) * FH_LANES);
+  const lmask active = position < counters->finished_length;
+  if (lanes_any(active)) {
+    const luint i = select((luint)(0), position, active);
+    const luint p = gather_uint(finished_queue, i);
+    const luint pixel = gather_uint(sample_id, p) % pixel_count, slot = gather_uint(local_pass, p) % FH_PASS_SLOTS;
+    lvec3 value = gather_xyz(radiance, p);
+    const lmask finite = isfinite(value.x) && isfinite(value.y) && isfinite(value.z);
+    value = v3_select(finite, value, v3_splat(0.0f));
+    scatter_xyzw(pass_buffer, slot * pixel_count + pixel, value, (lfloat)(1.0f), active);
+    scatter_uint(free_list, counters->free_length + i, p, active);
+    FH_FOR_LANES(l) {
+      if (!LANE(active, l)) continue;
+      atomic_inc(&finished_in_slot[LANE(slot, l)]);
       // Counted and reported (stats: nonfinite_samples); the tests require zero.
-      atomic_inc(&counters->nonfinite);
-      value = (float3)(0.0f);
+      if (!LANE(finite, l)) atomic_inc(&counters->nonfinite);
     }
-    pass_buffer[slot * pixel_count + pixel] = (float4)(value, 1.0f);
-    atomic_inc(&finished_in_slot[slot]);
-    free_list[counters->free_length + i] = p;
   }
   // One global atomic per pass slot and work-group (see queue_append).
   barrier(CLK_LOCAL_MEM_FENCE);

@@ -5,13 +5,13 @@
 #ifndef FH_FILM_H
 #define FH_FILM_H
 
-#include "types.h"
+#include "lanes.h"
 
 // Offset from the pixel centre for u in [0,1), from the filter's inverse CDF table.
-FH_INLINE float filter_offset(__global const float* table, uint size, float u) {
-  const float x = u * (float)(size - 1);
-  const uint i = min((uint)x, size - 2);
-  return mix(table[i], table[i + 1], x - (float)i);
+FH_INLINE lfloat filter_offset(__global const float* table, uint size, lfloat u) {
+  const lfloat x = u * (float)(size - 1);
+  const luint i = min(lconvert_uint(x), (luint)(size - 2));
+  return mix(gather_float(table, i), gather_float(table, i + 1), x - lconvert_float(i));
 }
 
 #endif

@@ -1,6 +1,6 @@
 // The generate stage: camera rays. generate starts the samples plan_iteration planned in
-// free path slots and queues them for intersection (the wavefront's refill);
-// generate_camera_rays makes one batch of camera rays for the debug views and the bench.
+// free path slots and queues them for intersection (the wavefront's refill), FH_LANES
+// samples per work-item (lanes.h).
 #include "camera.h"
 #include "film.h"
 #include "path_state.h"
@@ -14,41 +14,27 @@
 __kernel void generate(RenderParams params, __global const WavefrontCounters* counters,
                        __global const uint* free_list, __global uint* ray_queue, __global const float* filter_table,
                        __global const uint* pass_table FH_PATH_PARAMS) {
-  const uint i = get_global_id(0);
-  if (i >= counters->new_count) return;
-  const uint slot = free_list[counters->new_free_top - 1 - i];
-  const uint j = counters->new_first + i;
-  const uint pixel = j % params.pixel_count, device_pass = j / params.pixel_count;
-  const uint pass = pass_table[device_pass];
-  const uint k = pass * params.pixel_count + pixel;
+  const luint position = lane_positions(get_global_id(0) * FH_LANES);
+  const lmask active = position < counters->new_count;
+  if (!lanes_any(active)) return;
+  const luint i = select((luint)(0), position, active);  // idle lanes compute sample 0 and write nothing
+  const luint slot = gather_uint(free_list, counters->new_free_top - 1 - i);
+  const luint j = counters->new_first + i;
+  const luint pixel = j % params.pixel_count, device_pass = j / params.pixel_count;
+  const luint pass = gather_uint(pass_table, device_pass);
+  const luint k = pass * params.pixel_count + pixel;
   const PixelSampler sampler = pixel_sampler(params.seed, k, params.pixel_count);
-  const float2 u = sample_2d(&sampler, FH_DIM_PIXEL);
-  const float px = (float)(pixel % (uint)params.camera.width) + 0.5f +
-                   filter_offset(filter_table, params.filter_table_size, u.x);
-  const float py = (float)(pixel / (uint)params.camera.width) + 0.5f +
-                   filter_offset(filter_table, params.filter_table_size, u.y);
-  ray_org[slot] = (float4)(vload3(0, params.camera.origin), 0.0f);
-  ray_dir[slot] = (float4)(camera_ray_direction(&params.camera, px, py), INFINITY);
-  throughput[slot] = (float4)(1.0f, 1.0f, 1.0f, 0.0f);
-  ray_pdf[slot] = 0.0f;
-  radiance[slot] = (float4)(0.0f);
-  sample_id[slot] = k;
-  local_pass[slot] = device_pass;
-  depth[slot] = 0;
-  ray_queue[counters->new_queue_base + i] = slot;
-}
-
-__kernel void generate_camera_rays(CameraParams cam, uint seed, uint sample_index, uint first_pixel,
-                                   __global float4* out_org, __global float4* out_dir, __global uint* out_pixel,
-                                   uint ray_count) {
-  const uint i = get_global_id(0);
-  if (i >= ray_count) return;
-  const uint pixel_count = (uint)(cam.width * cam.height);
-  const uint pixel = (first_pixel + i) % pixel_count;
-  const uint stream = hash_combine(pixel, sample_index);
-  const float jx = random_float(seed, stream, 0), jy = random_float(seed, stream, 1);
-  const float px = (float)(pixel % (uint)cam.width) + jx, py = (float)(pixel / (uint)cam.width) + jy;
-  out_org[i] = (float4)(vload3(0, cam.origin), 0.0f);
-  out_dir[i] = (float4)(camera_ray_direction(&cam, px, py), INFINITY);
-  out_pixel[i] = pixel;
+  const lvec2 u = sample_2d(&sampler, (luint)(FH_DIM_PIXEL));
+  const uint width = (uint)params.camera.width;
+  const lfloat px = lconvert_float(pixel % width) + 0.5f + filter_offset(filter_table, params.filter_table_size, u.x);
+  const lfloat py = lconvert_float(pixel / width) + 0.5f + filter_offset(filter_table, params.filter_table_size, u.y);
+  scatter_xyzw(ray_org, slot, v3_uniform(vload3(0, params.camera.origin)), (lfloat)(0.0f), active);
+  scatter_xyzw(ray_dir, slot, camera_ray_direction(&params.camera, px, py), (lfloat)(INFINITY), active);
+  scatter_xyzw(throughput, slot, v3_splat(1.0f), (lfloat)(0.0f), active);
+  scatter_float(ray_pdf, slot, (lfloat)(0.0f), active);
+  scatter_xyzw(radiance, slot, v3_splat(0.0f), (lfloat)(0.0f), active);
+  scatter_uint(sample_id, slot, k, active);
+  scatter_uint(local_pass, slot, device_pass, active);
+  scatter_uint(depth, slot, (luint)(0), active);
+  scatter_uint(ray_queue, counters->new_queue_base + i, slot, active);
 }

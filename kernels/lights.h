@@ -4,44 +4,48 @@
 // formulation: Le f G V / p_area, with p_area = P(triangle) / area). Solid-angle sampling
 // bounds the estimate where area sampling's 1/r^2 is unbounded: a light next to the
 // receiver, e.g. across a concave edge of an emitting room, where area sampling's variance
-// is infinite.
+// is infinite. Lane-wise (lanes.h).
 #ifndef FH_LIGHTS_H
 #define FH_LIGHTS_H
 
+#include "ray.h"
 #include "sampling.h"
-#include "types.h"
 
-// The first light whose CDF value exceeds u (binary search).
-FH_INLINE uint pick_light(__global const float* cdf, uint count, float u) {
-  uint lo = 0, hi = count - 1;
-  while (lo < hi) {
-    const uint mid = (lo + hi) / 2;
-    if (cdf[mid] > u) hi = mid;
-    else lo = mid + 1;
+// The first light whose CDF value exceeds u (binary search), for each lane.
+FH_INLINE luint pick_light(__global const float* cdf, uint count, lfloat u) {
+  luint picked;
+  FH_FOR_LANES(l) {
+    uint lo = 0, hi = count - 1;
+    while (lo < hi) {
+      const uint mid = (lo + hi) / 2;
+      if (cdf[mid] > LANE(u, l)) hi = mid;
+      else lo = mid + 1;
+    }
+    LANE(picked, l) = lo;
   }
-  return lo;
+  return picked;
 }
 
 // Converts an area density at a point seen at distance^2 `dist2` under cosine `cos_light`
 // to a solid-angle density at the receiver.
-FH_INLINE float area_to_solid_angle(float pdf_area, float dist2, float cos_light) {
-  return cos_light > 0.0f ? pdf_area * dist2 / cos_light : 0.0f;
+FH_INLINE lfloat area_to_solid_angle(lfloat pdf_area, lfloat dist2, lfloat cos_light) {
+  return select((lfloat)(0.0f), pdf_area * dist2 / cos_light, cos_light > 0.0f);
 }
 
 // A triangle as seen from a point: unit directions to its corners and its solid angle
 // (Van Oosterom and Strackee 1983).
 typedef struct {
-  float3 a, b, c;
-  float solid_angle;
+  lvec3 a, b, c;
+  lfloat solid_angle;
 } SphericalTriangle;
 
-FH_INLINE SphericalTriangle spherical_triangle(float3 o, float3 v0, float3 v1, float3 v2) {
+FH_INLINE SphericalTriangle spherical_triangle(lvec3 o, lvec3 v0, lvec3 v1, lvec3 v2) {
   SphericalTriangle t;
-  t.a = normalize(v0 - o);
-  t.b = normalize(v1 - o);
-  t.c = normalize(v2 - o);
-  const float triple = fabs(dot(t.a, cross(t.b, t.c)));
-  t.solid_angle = 2.0f * atan2(triple, 1.0f + dot(t.a, t.b) + dot(t.b, t.c) + dot(t.c, t.a));
+  t.a = v3_normalize(v3_sub(v0, o));
+  t.b = v3_normalize(v3_sub(v1, o));
+  t.c = v3_normalize(v3_sub(v2, o));
+  const lfloat triple = fabs(v3_dot(t.a, v3_cross(t.b, t.c)));
+  t.solid_angle = 2.0f * atan2(triple, 1.0f + v3_dot(t.a, t.b) + v3_dot(t.b, t.c) + v3_dot(t.c, t.a));
   return t;
 }
 
@@ -52,56 +56,57 @@ FH_INLINE SphericalTriangle spherical_triangle(float3 o, float3 v0, float3 v1, f
 // (pbrt-v4's bounds); by area (solid_angle 0) otherwise, which costs less and is about as
 // good for small or distant lights. Light samples and the MIS weights of BSDF-found
 // emission both decide by this.
-FH_INLINE SphericalTriangle light_seen_from(float3 o, float3 v0, float3 v1, float3 v2, float area) {
-  const float3 to_centroid = (v0 + v1 + v2) * (1.0f / 3.0f) - o;
-  if (area <= 0.25f * dot(to_centroid, to_centroid)) {
-    SphericalTriangle by_area;
-    by_area.a = by_area.b = by_area.c = (float3)(0.0f);
-    by_area.solid_angle = 0.0f;
-    return by_area;
+FH_INLINE SphericalTriangle light_seen_from(lvec3 o, lvec3 v0, lvec3 v1, lvec3 v2, lfloat area) {
+  const lvec3 to_centroid = v3_sub(v3_scale(v3_add(v3_add(v0, v1), v2), 1.0f / 3.0f), o);
+  const lmask large = area > 0.25f * v3_dot(to_centroid, to_centroid);
+  SphericalTriangle t;
+  if (lanes_any(large)) {
+    t = spherical_triangle(o, v0, v1, v2);
+    t.solid_angle = select((lfloat)(0.0f), t.solid_angle, large && t.solid_angle > 3e-4f && t.solid_angle < 6.22f);
+  } else {
+    t.a = t.b = t.c = v3_splat(0.0f);
+    t.solid_angle = (lfloat)(0.0f);
   }
-  SphericalTriangle t = spherical_triangle(o, v0, v1, v2);
-  if (!(t.solid_angle > 3e-4f && t.solid_angle < 6.22f)) t.solid_angle = 0.0f;
   return t;
 }
 
-FH_INLINE float3 normalize_or(float3 v, float3 fallback) {
-  const float len2 = dot(v, v);
-  return len2 > 0.0f ? v * rsqrt(len2) : fallback;
+FH_INLINE lvec3 normalize_or(lvec3 v, lvec3 fallback) {
+  const lfloat len2 = v3_dot(v, v);
+  return v3_select(len2 > 0.0f, v3_scale(v, rsqrt(len2)), fallback);
 }
 
 // A direction uniform in the spherical triangle (Arvo, "Stratified sampling of spherical
 // triangles", 1995): u1 picks the sub-triangle with area u1 * solid angle, which fixes its
 // third corner on the arc a-c; u2 picks a point on the arc from b to that corner.
-FH_INLINE float3 sample_spherical_triangle(const SphericalTriangle* t, float u1, float u2) {
-  const float3 a = t->a, b = t->b, c = t->c;
+FH_INLINE lvec3 sample_spherical_triangle(const SphericalTriangle* t, lfloat u1, lfloat u2) {
+  const lvec3 a = t->a, b = t->b, c = t->c;
   // The angle at corner a between the great circles a-b and a-c.
-  const float3 n_ab = normalize_or(cross(a, b), (float3)(0.0f)), n_ac = normalize_or(cross(a, c), (float3)(0.0f));
-  const float cos_alpha = clamp(dot(n_ab, n_ac), -1.0f, 1.0f), sin_alpha = sqrt(fmax(0.0f, 1.0f - cos_alpha * cos_alpha));
+  const lvec3 n_ab = normalize_or(v3_cross(a, b), v3_splat(0.0f)), n_ac = normalize_or(v3_cross(a, c), v3_splat(0.0f));
+  const lfloat cos_alpha = clamp(v3_dot(n_ab, n_ac), -1.0f, 1.0f);
+  const lfloat sin_alpha = sqrt(fmax(0.0f, 1.0f - cos_alpha * cos_alpha));
   // sin and cos of (u1 * solid angle - alpha), by the angle-difference identities.
-  const float2 sc = sincos_reduced(u1 * t->solid_angle);
-  const float s = sc.x * cos_alpha - sc.y * sin_alpha, tt = sc.y * cos_alpha + sc.x * sin_alpha;
-  const float u = tt - cos_alpha, v = s + sin_alpha * dot(a, b);
-  const float denominator = (v * s + u * tt) * sin_alpha;
-  const float q = denominator != 0.0f ? clamp(((v * tt - u * s) * cos_alpha - v) / denominator, -1.0f, 1.0f) : 1.0f;
-  const float3 c_hat = q * a + sqrt(fmax(0.0f, 1.0f - q * q)) * normalize_or(c - dot(c, a) * a, c);
-  const float z = 1.0f - u2 * (1.0f - dot(c_hat, b));
-  return normalize(z * b + sqrt(fmax(0.0f, 1.0f - z * z)) * normalize_or(c_hat - dot(c_hat, b) * b, c_hat));
+  const lvec2 sc = sincos_reduced(u1 * t->solid_angle);
+  const lfloat s = sc.x * cos_alpha - sc.y * sin_alpha, tt = sc.y * cos_alpha + sc.x * sin_alpha;
+  const lfloat u = tt - cos_alpha, v = s + sin_alpha * v3_dot(a, b);
+  const lfloat denominator = (v * s + u * tt) * sin_alpha;
+  const lfloat q = select((lfloat)(1.0f), clamp(((v * tt - u * s) * cos_alpha - v) / denominator, -1.0f, 1.0f),
+                          denominator != 0.0f);
+  const lvec3 c_hat = v3_add(v3_scale(a, q), v3_scale(normalize_or(v3_sub(c, v3_scale(a, v3_dot(c, a))), c),
+                                                      sqrt(fmax(0.0f, 1.0f - q * q))));
+  const lfloat z = 1.0f - u2 * (1.0f - v3_dot(c_hat, b));
+  return v3_normalize(v3_add(v3_scale(b, z), v3_scale(normalize_or(v3_sub(c_hat, v3_scale(b, v3_dot(c_hat, b))), c_hat),
+                                                      sqrt(fmax(0.0f, 1.0f - z * z)))));
 }
 
 // Barycentrics (b1, b2) of the point where the ray o + s w meets the plane of the triangle
 // (Moller-Trumbore), clamped into the triangle: a direction drawn inside the spherical
 // triangle hits it up to rounding.
-FH_INLINE float2 barycentrics_along(float3 o, float3 w, float3 v0, float3 v1, float3 v2) {
-  const float3 e1 = v1 - v0, e2 = v2 - v0, p = cross(w, e2), d = o - v0, q = cross(d, e1);
-  const float inv = 1.0f / dot(e1, p);
-  float b1 = clamp(dot(d, p) * inv, 0.0f, 1.0f), b2 = clamp(dot(w, q) * inv, 0.0f, 1.0f);
-  const float excess = b1 + b2 - 1.0f;
-  if (excess > 0.0f) {
-    b1 -= 0.5f * excess;
-    b2 -= 0.5f * excess;
-  }
-  return (float2)(b1, b2);
+FH_INLINE lvec2 barycentrics_along(lvec3 o, lvec3 w, lvec3 v0, lvec3 v1, lvec3 v2) {
+  const lvec3 e1 = v3_sub(v1, v0), e2 = v3_sub(v2, v0), p = v3_cross(w, e2), d = v3_sub(o, v0), q = v3_cross(d, e1);
+  const lfloat inv = 1.0f / v3_dot(e1, p);
+  const lfloat b1 = clamp(v3_dot(d, p) * inv, 0.0f, 1.0f), b2 = clamp(v3_dot(w, q) * inv, 0.0f, 1.0f);
+  const lfloat excess = fmax(b1 + b2 - 1.0f, 0.0f);
+  return lv2(b1 - 0.5f * excess, b2 - 0.5f * excess);
 }
 
 // A light triangle as light sampling treats it from a receiver's ray origin: its corners,
@@ -109,17 +114,17 @@ FH_INLINE float2 barycentrics_along(float3 o, float3 w, float3 v0, float3 v1, fl
 // (seen.solid_angle > 0: by solid angle). shadow_connect samples with it and shade weighs
 // BSDF-found emission with it, so both use one density (light_pdf) for the same point.
 typedef struct {
-  float3 v0, v1, v2;
-  float area, pick;
+  lvec3 v0, v1, v2;
+  lfloat area, pick;
   SphericalTriangle seen;
 } LightTriangle;
 
-FH_INLINE LightTriangle light_triangle_from(__global const float4* triangles, int t, float pdf_area, float3 origin) {
+FH_INLINE LightTriangle light_triangle_from(__global const float4* triangles, lint t, lfloat pdf_area, lvec3 origin) {
   LightTriangle l;
-  l.v0 = triangles[3 * t].xyz;
-  l.v1 = triangles[3 * t + 1].xyz;
-  l.v2 = triangles[3 * t + 2].xyz;
-  l.area = 0.5f * length(cross(l.v1 - l.v0, l.v2 - l.v0));
+  l.v0 = triangle_corner(triangles, t, 0);
+  l.v1 = triangle_corner(triangles, t, 1);
+  l.v2 = triangle_corner(triangles, t, 2);
+  l.area = 0.5f * v3_length(v3_cross(v3_sub(l.v1, l.v0), v3_sub(l.v2, l.v0)));
   l.pick = pdf_area * l.area;  // pdf_area = P(triangle) / area
   l.seen = light_seen_from(origin, l.v0, l.v1, l.v2, l.area);
   return l;
@@ -127,15 +132,15 @@ FH_INLINE LightTriangle light_triangle_from(__global const float4* triangles, in
 
 // The density (per solid angle at the receiver) with which light sampling picks a point of
 // light triangle l at squared distance dist2, seen under cos_light.
-FH_INLINE float light_pdf(const LightTriangle* l, float dist2, float cos_light) {
-  if (l->seen.solid_angle > 0.0f) return l->pick / l->seen.solid_angle;
-  return area_to_solid_angle(l->pick / l->area, dist2, cos_light);
+FH_INLINE lfloat light_pdf(const LightTriangle* l, lfloat dist2, lfloat cos_light) {
+  return select(area_to_solid_angle(l->pick / l->area, dist2, cos_light), l->pick / l->seen.solid_angle,
+                l->seen.solid_angle > 0.0f);
 }
 
 // The power heuristic (beta = 2) weight of a sample drawn with density `a` against `b`.
-FH_INLINE float power_heuristic(float a, float b) {
-  const float a2 = a * a, b2 = b * b;
-  return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+FH_INLINE lfloat power_heuristic(lfloat a, lfloat b) {
+  const lfloat a2 = a * a, b2 = b * b;
+  return select((lfloat)(0.0f), a2 / (a2 + b2), a2 + b2 > 0.0f);
 }
 
 #endif

@@ -7,13 +7,13 @@
 // Owen scrambling (every point still uniform: the estimator stays unbiased) and its own
 // shuffle of the sample order (so pairs of dimensions are not correlated with each other):
 // Burley, "Practical Hash-based Owen Scrambling", JCGT 2020, with its Laine-Karras style
-// hash (owen_hash below).
+// hash (owen_hash below). Lane-wise (lanes.h): each lane is its own sample.
 #ifndef FH_SAMPLER_H
 #define FH_SAMPLER_H
 
 #include "rng.h"
 
-FH_INLINE uint reverse_bits_u32(uint x) {
+FH_INLINE luint reverse_bits_u32(luint x) {
   x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
   x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
   x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
@@ -25,7 +25,7 @@ FH_INLINE uint reverse_bits_u32(uint x) {
 // multiplications carry upward only). Applied to a number whose bits are digits in reverse
 // order, it flips each digit by a function of the more significant digits: an Owen
 // scrambling. (The Laine-Karras construction, with the constants of Burley 2020.)
-FH_INLINE uint owen_hash(uint x, uint seed) {
+FH_INLINE luint owen_hash(luint x, luint seed) {
   x += seed;
   x ^= x * 0x6c50b47cu;
   x ^= x * 0xb82f1e52u;
@@ -39,7 +39,7 @@ FH_INLINE uint owen_hash(uint x, uint seed) {
 // triangle mod 2, so digit k is the XOR of the index bits m whose bit pattern contains k's
 // (Lucas), a superset sum computed in five steps. (The first dimension, van der Corput,
 // reversed, is the index itself.)
-FH_INLINE uint sobol_second_dimension_reversed(uint j) {
+FH_INLINE luint sobol_second_dimension_reversed(luint j) {
   j ^= (j >> 1) & 0x55555555u;
   j ^= (j >> 2) & 0x33333333u;
   j ^= (j >> 4) & 0x0f0f0f0fu;
@@ -51,13 +51,13 @@ FH_INLINE uint sobol_second_dimension_reversed(uint j) {
 // One sample of one pixel: the pixel's scrambling seed and the sample's index (its pass)
 // with the bits reversed, as the index shuffle takes it.
 typedef struct {
-  uint pixel_seed;
-  uint index_reversed;
+  luint pixel_seed;
+  luint index_reversed;
 } PixelSampler;
 
-FH_INLINE PixelSampler pixel_sampler(uint seed, uint sample_id, uint pixel_count) {
+FH_INLINE PixelSampler pixel_sampler(uint seed, luint sample_id, uint pixel_count) {
   PixelSampler s;
-  s.pixel_seed = hash_combine(seed, sample_id % pixel_count);
+  s.pixel_seed = hash_combine((luint)(seed), sample_id % pixel_count);
   s.index_reversed = reverse_bits_u32(sample_id / pixel_count);
   return s;
 }
@@ -65,25 +65,25 @@ FH_INLINE PixelSampler pixel_sampler(uint seed, uint sample_id, uint pixel_count
 // The index of this sample in dimension `dimension`'s own order: an Owen scrambling of the
 // index, which maps every aligned block of 2^k indices onto another such block, so the first
 // 2^k samples of a pixel stay a net in every dimension while the dimensions are decorrelated.
-FH_INLINE uint shuffled_index(const PixelSampler* s, uint seed) {
+FH_INLINE luint shuffled_index(const PixelSampler* s, luint seed) {
   return reverse_bits_u32(owen_hash(s->index_reversed, seed));
 }
 
 // A digit-reversed coordinate, Owen-scrambled and put back in order, as a float in [0, 1).
-FH_INLINE float scrambled_unit(uint digits_reversed, uint seed) {
+FH_INLINE lfloat scrambled_unit(luint digits_reversed, luint seed) {
   return u32_to_unit_float(reverse_bits_u32(owen_hash(digits_reversed, seed)));
 }
 
-FH_INLINE float sample_1d(const PixelSampler* s, uint dimension) {
-  const uint seed = hash_combine(s->pixel_seed, dimension);
+FH_INLINE lfloat sample_1d(const PixelSampler* s, luint dimension) {
+  const luint seed = hash_combine(s->pixel_seed, dimension);
   return scrambled_unit(shuffled_index(s, seed), hash_u32(seed));
 }
 
 // Dimensions `dimension` and `dimension + 1` together.
-FH_INLINE float2 sample_2d(const PixelSampler* s, uint dimension) {
-  const uint seed = hash_combine(s->pixel_seed, dimension);
-  const uint j = shuffled_index(s, seed);
-  return (float2)(scrambled_unit(j, hash_u32(seed)), scrambled_unit(sobol_second_dimension_reversed(j), hash_u32(seed + 1u)));
+FH_INLINE lvec2 sample_2d(const PixelSampler* s, luint dimension) {
+  const luint seed = hash_combine(s->pixel_seed, dimension);
+  const luint j = shuffled_index(s, seed);
+  return lv2(scrambled_unit(j, hash_u32(seed)), scrambled_unit(sobol_second_dimension_reversed(j), hash_u32(seed + 1u)));
 }
 
 #endif

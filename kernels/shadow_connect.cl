@@ -2,6 +2,8 @@
 // shade queued. Picks an emissive triangle in proportion to its power and a point on it
 // (uniform in the solid angle it subtends, or in area: lights.h), traces the shadow ray
 // (V(x,y)), and adds the unoccluded contribution, weighted against BSDF sampling for mis.
+// Each work-item connects FH_LANES consecutive requests (lanes.h); their shadow rays are
+// traced one after the other.
 #include "bsdf.h"
 #include "intersect.h"
 #include "lights.h"
@@ -16,58 +18,67 @@ __kernel void shadow_connect(RenderParams params, __global const WavefrontCounte
                              __global const GpuMaterial* materials, __global const float* light_cdf,
                              __global const int* light_triangle, __global const float* light_pdf_area
                                  FH_PATH_PARAMS FH_SHADOW_PARAMS) {
-  const uint i = get_global_id(0);
-  if (i >= counters->shadow_length) return;
-  const uint p = shadow_path[i];
-  const float4 position = shadow_position[i];
+  const luint position = lane_positions(get_global_id(0) * FH_LANES);
+  const lmask active = position < counters->shadow_length;
+  if (!lanes_any(active)) return;
+  const luint i = select((luint)(0), position, active);  // idle lanes read request 0
+  const luint p = gather_uint(shadow_path, i);
   SurfacePoint s;
-  s.position = position.xyz;
-  s.magnitude = position.w;
-  s.normal = shadow_geometric[i].xyz;  // the geometric normal on the viewer's side
-  const float3 n = shadow_normal[i].xyz;  // the shading normal, same side
-  const float3 beta = shadow_throughput[i].xyz;
-  const PixelSampler sampler = pixel_sampler(params.seed, sample_id[p], params.pixel_count);
-  const uint dim = shadow_depth[i] * FH_DIMS_PER_BOUNCE;
+  s.position = gather_xyz(shadow_position, i);
+  s.magnitude = gather_w(shadow_position, i);
+  s.normal = gather_xyz(shadow_geometric, i);  // the geometric normal on the viewer's side
+  const lvec3 n = gather_xyz(shadow_normal, i);  // the shading normal, same side
+  const PixelSampler sampler = pixel_sampler(params.seed, gather_uint(sample_id, p), params.pixel_count);
+  const luint dim = gather_uint(shadow_depth, i) * FH_DIMS_PER_BOUNCE;
 
   // Connect from the point just off the surface that BSDF-sampled rays also start from:
   // both strategies then see the same geometry, and their MIS weights sum to one even
   // where the offset is a visible distance (far from the origin).
-  const float3 origin = offset_ray_origin(&s, s.normal);
-  const uint light = pick_light(light_cdf, params.light_count, sample_1d(&sampler, dim + FH_DIM_LIGHT_PICK));
-  const int lt = light_triangle[light];
-  const LightTriangle light_tri = light_triangle_from(triangles, lt, light_pdf_area[lt], origin);
-  const float2 u = sample_2d(&sampler, dim + FH_DIM_LIGHT_U1);
-  const float2 b = light_tri.seen.solid_angle > 0.0f
-                       ? barycentrics_along(origin, sample_spherical_triangle(&light_tri.seen, u.x, u.y), light_tri.v0,
-                                            light_tri.v1, light_tri.v2)
-                       : sample_triangle(u.x, u.y);
+  const lvec3 origin = offset_ray_origin(&s, s.normal);
+  const luint light = pick_light(light_cdf, params.light_count, sample_1d(&sampler, dim + FH_DIM_LIGHT_PICK));
+  const lint lt = gather_int(light_triangle, light);
+  const LightTriangle light_tri = light_triangle_from(triangles, lt, gather_float(light_pdf_area, las_uint(lt)), origin);
+  const lvec2 u = sample_2d(&sampler, dim + FH_DIM_LIGHT_U1);
+  lvec2 b = sample_triangle(u.x, u.y);
+  const lmask by_angle = light_tri.seen.solid_angle > 0.0f;
+  if (lanes_any(by_angle)) {
+    const lvec2 along = barycentrics_along(origin, sample_spherical_triangle(&light_tri.seen, u.x, u.y), light_tri.v0,
+                                           light_tri.v1, light_tri.v2);
+    b = lv2(select(b.x, along.x, by_angle), select(b.y, along.y, by_angle));
+  }
   const SurfacePoint l = surface_point(triangles, lt, b.x, b.y);
-  const float3 to_light = l.position - origin;
-  const float dist2 = dot(to_light, to_light);
-  if (!(dist2 > 0.0f)) return;
-  const float3 wi = to_light * rsqrt(dist2);
-  const float cos_surface = dot(n, wi), cos_light = -dot(l.normal, wi);
+  const lvec3 to_light = v3_sub(l.position, origin);
+  const lfloat dist2 = v3_dot(to_light, to_light);
+  const lvec3 wi = v3_scale(to_light, rsqrt(dist2));
+  const lfloat cos_surface = v3_dot(n, wi), cos_light = -v3_dot(l.normal, wi);
   // Behind the surface (by either normal: no light leaks through), or the light's back.
-  if (cos_surface <= 0.0f || dot(s.normal, wi) <= 0.0f || cos_light <= 0.0f) return;
+  lmask connects = active && dist2 > 0.0f && cos_surface > 0.0f && v3_dot(s.normal, wi) > 0.0f && cos_light > 0.0f;
+  if (!lanes_any(connects)) return;
 
-  Bsdf bsdf = material_bsdf(materials + shadow_material[i]);
-  bsdf.kd = shadow_albedo[i].xyz;  // textured or not, as shade found it
-  const float3 wo = shadow_wo[i].xyz;
-  const float3 f = bsdf_eval(&bsdf, n, wo, wi);
-  const float pdf_light = light_pdf(&light_tri, dist2, cos_light);
+  const MaterialLanes m = material_lanes(materials, gather_int(shadow_material, i));
+  Bsdf bsdf = material_bsdf(&m);
+  bsdf.kd = gather_xyz(shadow_albedo, i);  // textured or not, as shade found it
+  const lvec3 wo = gather_xyz(shadow_wo, i);
+  const lvec3 f = bsdf_eval(&bsdf, n, wo, wi);
+  const lfloat pdf_light = light_pdf(&light_tri, dist2, cos_light);
 #if defined(FH_METHOD_MIS)
-  const float weight = power_heuristic(pdf_light, bsdf_pdf(&bsdf, n, wo, wi));
+  const lfloat weight = power_heuristic(pdf_light, bsdf_pdf(&bsdf, n, wo, wi));
 #else
-  const float weight = 1.0f;
+  const lfloat weight = (lfloat)(1.0f);
 #endif
-  const float3 ke = vload3(0, materials[triangle_material[lt]].ke);
-  const float3 contribution = beta * f * ke * (cos_surface * weight / pdf_light);
-  if (!(contribution.x > 0.0f || contribution.y > 0.0f || contribution.z > 0.0f)) return;
+  const lvec3 ke = material_lanes(materials, gather_int(triangle_material, las_uint(lt))).ke;
+  const lvec3 contribution = v3_scale(v3_mul(v3_mul(gather_xyz(shadow_throughput, i), f), ke), cos_surface * weight / pdf_light);
+  connects = connects && v3_any_positive(contribution);
 
   // V(x, y): the segment from just off the surface to just short of the light point.
-  const float3 target = offset_ray_origin(&l, -wi);
-  const float3 d = target - origin;
-  const float dist = length(d);
-  if (trace_ray(nodes, blocks, origin, d / dist, 0.0f, dist * FH_SHADOW_SHORTEN, true).triangle >= 0) return;
-  radiance[p] += (float4)(contribution, 0.0f);
+  const lvec3 d = v3_sub(offset_ray_origin(&l, v3_neg(wi)), origin);
+  const lfloat dist = v3_length(d);
+  const lvec3 direction = v3_scale(d, 1.0f / dist);
+  FH_FOR_LANES(k) {
+    if (!LANE(connects, k)) continue;
+    if (trace_ray(nodes, blocks, v3_lane(origin, k), v3_lane(direction, k), 0.0f, LANE(dist, k) * FH_SHADOW_SHORTEN, true)
+            .triangle >= 0)
+      continue;
+    radiance[LANE(p, k)] += (float4)(v3_lane(contribution, k), 0.0f);
+  }
 }

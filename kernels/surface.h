@@ -1,15 +1,16 @@
 // What shading needs at a hit beyond its geometry, each only when the scene has it (the
 // host compiles with FH_SHADING_NORMALS and FH_TEXTURES only then): the interpolated
 // shading normal and the diffuse albedo from map_Kd (bilinear, wrapping, stored linear).
+// Lane-wise (lanes.h).
 #ifndef FH_SURFACE_H
 #define FH_SURFACE_H
 
-#include "types.h"
+#include "ray.h"
 
 // Texture i covers texels[offset .. offset + width * height) (float4, linear RGB, rows
-// from the top); texture_info[i] = (offset, width, height, unused).
-FH_INLINE float3 texture_lookup(__global const float4* texels, __global const uint4* texture_info, int texture,
-                                float2 uv) {
+// from the top); texture_info[i] = (offset, width, height, unused). One lookup.
+FH_INLINE float3 texture_texel(__global const float4* texels, __global const uint4* texture_info, int texture,
+                               float2 uv) {
   const uint4 info = texture_info[texture];
   const float w = (float)info.y, h = (float)info.z;
   // OBJ's v runs up the image; texel rows run down it.
@@ -24,18 +25,36 @@ FH_INLINE float3 texture_lookup(__global const float4* texels, __global const ui
   return mix(top, bottom, ty).xyz;
 }
 
-// The shading normal at barycentrics (b1, b2), turned to the side of `ng` (the geometric
-// normal on the viewer's side): interpolated normals may disagree with the winding.
-FH_INLINE float3 shading_normal(__global const float4* normals, int t, float b1, float b2, float3 ng) {
-  const float3 n = (1.0f - b1 - b2) * normals[3 * t].xyz + b1 * normals[3 * t + 1].xyz + b2 * normals[3 * t + 2].xyz;
-  const float len = length(n);
-  if (!(len > 0.0f)) return ng;
-  const float3 ns = n / len;
-  return dot(ns, ng) >= 0.0f ? ns : -ns;
+// The textured albedo in the lanes with a texture (texture >= 0), `albedo` in the others.
+// Texture fetches are gathers whatever the lanes, so each lane looks up its own.
+FH_INLINE lvec3 texture_lookup(__global const float4* texels, __global const uint4* texture_info, lint texture,
+                               lvec2 uv, lvec3 albedo) {
+  FH_FOR_LANES(l) {
+    if (LANE(texture, l) < 0) continue;
+    const float3 c = texture_texel(texels, texture_info, LANE(texture, l), (float2)(LANE(uv.x, l), LANE(uv.y, l)));
+    LANE(albedo.x, l) = c.x;
+    LANE(albedo.y, l) = c.y;
+    LANE(albedo.z, l) = c.z;
+  }
+  return albedo;
 }
 
-FH_INLINE float2 surface_uv(__global const float2* uvs, int t, float b1, float b2) {
-  return (1.0f - b1 - b2) * uvs[3 * t] + b1 * uvs[3 * t + 1] + b2 * uvs[3 * t + 2];
+// The shading normal at barycentrics (b1, b2), turned to the side of `ng` (the geometric
+// normal on the viewer's side): interpolated normals may disagree with the winding.
+// Zero normals (a scene without any, under a kernel compiled with every feature) give ng.
+FH_INLINE lvec3 shading_normal(__global const float4* normals, lint t, lfloat b1, lfloat b2, lvec3 ng) {
+  const lvec3 n = v3_add(v3_add(v3_scale(triangle_corner(normals, t, 0), 1.0f - b1 - b2),
+                                v3_scale(triangle_corner(normals, t, 1), b1)),
+                         v3_scale(triangle_corner(normals, t, 2), b2));
+  const lvec3 ns = v3_normalize(n);
+  return v3_select(!(v3_dot(n, n) > 0.0f), ng, v3_select(v3_dot(ns, ng) >= 0.0f, ns, v3_neg(ns)));
+}
+
+FH_INLINE lvec2 surface_uv(__global const float2* uvs, lint t, lfloat b1, lfloat b2) {
+  const luint i = las_uint(3 * t);
+  const lvec2 a = gather_xy(uvs, i), b = gather_xy(uvs, i + 1), c = gather_xy(uvs, i + 2);
+  const lfloat w = 1.0f - b1 - b2;
+  return lv2(w * a.x + b1 * b.x + b2 * c.x, w * a.y + b1 * b.y + b2 * c.y);
 }
 
 #endif

@@ -12,10 +12,11 @@ std::vector<ProgramSpec> everyProgramVariant() {
   const std::string traversal = "-DFH_TRAVERSAL_STACK=64";
   std::vector<ProgramSpec> programs = {intersectProgram(traversal), benchRaysProgram(traversal), aovProgram()};
   for (Method method : {Method::PT, Method::NEE, Method::MIS})
-    for (unsigned bits = 0; bits < 16; ++bits) {
-      const SceneFeatures features{(bits & 1) != 0, (bits & 2) != 0, (bits & 4) != 0, (bits & 8) != 0};
-      programs.push_back(pathTracerProgram(features, method, FH_MAX_PASS_SLOTS, traversal));
-    }
+    for (unsigned bits = 0; bits < 16; ++bits)
+      for (Strategy strategy : {Strategy::Scalar, Strategy::Simd8}) {
+        const SceneFeatures features{(bits & 1) != 0, (bits & 2) != 0, (bits & 4) != 0, (bits & 8) != 0};
+        programs.push_back(pathTracerProgram(features, method, FH_MAX_PASS_SLOTS, traversal, strategy));
+      }
   return programs;
 }
 

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 
 #include <OpenImageIO/imageio.h>
 
@@ -22,31 +23,37 @@ namespace fh {
 namespace {
 
 const char* kTestKernels = R"CL(
+// FH_LANES samples per work-item (kernels/lanes.h), as the path tracer's strategies take them.
 __kernel void sample_bsdf(__global const GpuMaterial* m, float4 wo, uint seed, __global float4* wi_pdf,
                           __global float4* weight) {
-  const uint i = get_global_id(0);
-  const Bsdf b = material_bsdf(m);
-  float3 wi;
-  float pdf;
-  const float3 n = (float3)(0.0f, 0.0f, 1.0f);
-  const float3 w = bsdf_sample(&b, n, n, wo.xyz, random_float(seed, i, 0),
-                               random_float(seed, i, 1), random_float(seed, i, 2), &wi, &pdf);
-  wi_pdf[i] = (float4)(wi, pdf);
-  weight[i] = (float4)(w, 0.0f);
+  const luint i = lane_positions(get_global_id(0) * FH_LANES);
+  const MaterialLanes material = material_lanes(m, (lint)(0));
+  const Bsdf b = material_bsdf(&material);
+  const lvec3 n = v3_uniform((float3)(0.0f, 0.0f, 1.0f));
+  const BsdfSample s = bsdf_sample(&b, n, n, v3_uniform(wo.xyz), random_float((luint)(seed), i, (luint)(0)),
+                                   random_float((luint)(seed), i, (luint)(1)), random_float((luint)(seed), i, (luint)(2)));
+  scatter_xyzw(wi_pdf, i, s.wi, s.pdf, lanes_mask(true));
+  scatter_xyzw(weight, i, s.weight, (lfloat)(0.0f), lanes_mask(true));
 }
 __kernel void pdf_bsdf(__global const GpuMaterial* m, float4 wo, __global const float4* wi, __global float* pdf) {
-  const uint i = get_global_id(0);
-  const Bsdf b = material_bsdf(m);
-  pdf[i] = bsdf_pdf(&b, (float3)(0.0f, 0.0f, 1.0f), wo.xyz, wi[i].xyz);
+  const luint i = lane_positions(get_global_id(0) * FH_LANES);
+  const MaterialLanes material = material_lanes(m, (lint)(0));
+  const Bsdf b = material_bsdf(&material);
+  scatter_float(pdf, i, bsdf_pdf(&b, v3_uniform((float3)(0.0f, 0.0f, 1.0f)), v3_uniform(wo.xyz), gather_xyz(wi, i)),
+                lanes_mask(true));
 }
 )CL";
 
 class BsdfOnDevice : public ::testing::Test {
  protected:
   DeviceContext dc{selectDevices(listDevices(), "").front()};
-  cl::Program program = buildProgramFromSource(
-      dc.context, dc.info.device, assembleKernelSources({"bsdf.h", "rng.h"}) + kTestKernels,
-      "-DFH_GLOSSY -DFH_GLASS");
+  // One path per work-item and eight in vector lanes: the two strategies' BSDF code.
+  std::array<cl::Program, 2> programs = {program(1), program(8)};
+  cl::Program program(int lanes) {
+    return buildProgramFromSource(dc.context, dc.info.device,
+                                  assembleKernelSources({"bsdf.h", "rng.h"}) + kTestKernels,
+                                  "-DFH_GLOSSY -DFH_GLASS -DFH_LANES=" + std::to_string(lanes));
+  }
 
   static gpu::GpuMaterial material(float kd, float ks, float ns, int illum, float ni = 1.5f, float tf = 1.f) {
     Scene s;
@@ -65,7 +72,16 @@ class BsdfOnDevice : public ::testing::Test {
     std::vector<float> wiPdf, weight;
   };
 
+  // n samples with both strategies' code, which must agree bit for bit.
   Samples sample(const gpu::GpuMaterial& m, const float3& wo, size_t n, unsigned seed = 1) {
+    const Samples one = sample(programs[0], 1, m, wo, n, seed), eight = sample(programs[1], 8, m, wo, n, seed);
+    EXPECT_EQ(0, std::memcmp(one.wiPdf.data(), eight.wiPdf.data(), n * 16)) << "one lane and eight disagree";
+    EXPECT_EQ(0, std::memcmp(one.weight.data(), eight.weight.data(), n * 16)) << "one lane and eight disagree";
+    return one;
+  }
+  Samples sample(const cl::Program& program, size_t lanes, const gpu::GpuMaterial& m, const float3& wo, size_t n,
+                 unsigned seed) {
+    EXPECT_EQ(0u, n % lanes);
     cl::Buffer mb = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, sizeof m, "material", &m);
     cl::Buffer a = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, n * 16, "wi");
     cl::Buffer b = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, n * 16, "weight");
@@ -76,7 +92,7 @@ class BsdfOnDevice : public ::testing::Test {
     FH_CL(k.setArg(2, seed));
     FH_CL(k.setArg(3, a));
     FH_CL(k.setArg(4, b));
-    FH_CL(dc.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n), cl::NDRange(64)));
+    FH_CL(dc.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n / lanes)));
     Samples s{std::vector<float>(n * 4), std::vector<float>(n * 4)};
     FH_CL(dc.queue.enqueueReadBuffer(a, CL_TRUE, 0, n * 16, s.wiPdf.data()));
     FH_CL(dc.queue.enqueueReadBuffer(b, CL_TRUE, 0, n * 16, s.weight.data()));
@@ -84,7 +100,14 @@ class BsdfOnDevice : public ::testing::Test {
   }
 
   std::vector<float> pdf(const gpu::GpuMaterial& m, const float3& wo, const std::vector<float>& dirs) {
+    const std::vector<float> one = pdf(programs[0], 1, m, wo, dirs), eight = pdf(programs[1], 8, m, wo, dirs);
+    EXPECT_EQ(one, eight) << "one lane and eight disagree";
+    return one;
+  }
+  std::vector<float> pdf(const cl::Program& program, size_t lanes, const gpu::GpuMaterial& m, const float3& wo,
+                         const std::vector<float>& dirs) {
     const size_t n = dirs.size() / 4;
+    EXPECT_EQ(0u, n % lanes);
     cl::Buffer mb = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, sizeof m, "material", &m);
     cl::Buffer d = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, n * 16, "dirs", dirs.data());
     cl::Buffer out = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, n * 4, "pdf");
@@ -94,7 +117,7 @@ class BsdfOnDevice : public ::testing::Test {
     FH_CL(k.setArg(1, w));
     FH_CL(k.setArg(2, d));
     FH_CL(k.setArg(3, out));
-    FH_CL(dc.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n), cl::NDRange(64)));
+    FH_CL(dc.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n / lanes)));
     std::vector<float> p(n);
     FH_CL(dc.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * 4, p.data()));
     return p;
@@ -261,7 +284,7 @@ TEST(WhiteFurnace, LosslessObjectsVanishInAUniformEnclosure) {
     const Scene scene = furnaceWith(object);
     const Bvh bvh = buildBvh(scene);
     for (Method method : {Method::PT, Method::NEE, Method::MIS}) {
-      RenderSettings s;
+      RenderSettings s = test::renderSettings();
       s.width = s.height = 16;
       s.spp = 64;
       s.method = method;
@@ -292,7 +315,7 @@ TEST(Textures, LookupIsBilinearAndWrapsAtTheSeams) {
 __kernel void lookup(__global const float4* texels, __global const uint4* info, __global const float2* uv,
                      __global float4* out) {
   const uint i = get_global_id(0);
-  out[i] = (float4)(texture_lookup(texels, info, 0, uv[i]), 0.0f);
+  out[i] = (float4)(texture_texel(texels, info, 0, uv[i]), 0.0f);
 }
 )CL";
   DeviceContext dc(selectDevices(listDevices(), "").front());
@@ -367,7 +390,7 @@ TEST(Textures, AlbedoComesFromTheImageDecodedToLinear) {
   camera.fovYDeg = 20.f;
   DeviceContext dc(selectDevices(listDevices(), "").front());
   const Bvh bvh = buildBvh(scene);
-  RenderSettings s;
+  RenderSettings s = test::renderSettings();
   s.width = s.height = 8;
   s.spp = 16;
   s.method = Method::PT;

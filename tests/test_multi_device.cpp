@@ -28,7 +28,7 @@ struct TwoDevices : ::testing::Test {
   Scene scene = loadDefaultScene();
   Bvh bvh = buildBvh(scene);
   RenderSettings settings = [] {
-    RenderSettings s;
+    RenderSettings s = test::renderSettings();
     s.width = s.height = 24;
     s.spp = 64;
     s.seed = 9;

@@ -57,8 +57,8 @@ TEST_F(ProgramOnDevice, SecondBuildComesFromTheCache) {
   // A nonce in the options makes the first build cold even if an earlier run cached it.
   const std::string options = "-DFH_TEST_NONCE=" + std::to_string(std::random_device{}());
   ProgramBuildInfo first, second;
-  buildProgram(dc.context, dc.info.device, {"generate.cl"}, options, &first);
-  const cl::Program program = buildProgram(dc.context, dc.info.device, {"generate.cl"}, options, &second);
+  buildProgram(dc.context, dc.info.device, {"camera_rays.cl"}, options, &first);
+  const cl::Program program = buildProgram(dc.context, dc.info.device, {"camera_rays.cl"}, options, &second);
   EXPECT_FALSE(first.fromCache);
   EXPECT_TRUE(second.fromCache);
   EXPECT_EQ(first.cacheFile, second.cacheFile);
@@ -66,21 +66,21 @@ TEST_F(ProgramOnDevice, SecondBuildComesFromTheCache) {
   EXPECT_NO_THROW(createKernel(program, "generate_camera_rays"));
   // Other options are another program.
   ProgramBuildInfo other;
-  buildProgram(dc.context, dc.info.device, {"generate.cl"}, options + " -DFH_OTHER=1", &other);
+  buildProgram(dc.context, dc.info.device, {"camera_rays.cl"}, options + " -DFH_OTHER=1", &other);
   EXPECT_FALSE(other.fromCache);
 }
 
 TEST_F(ProgramOnDevice, CorruptCacheFileFallsBackToSource) {
   const std::string options = "-DFH_TEST_NONCE=" + std::to_string(std::random_device{}());
   ProgramBuildInfo first, second;
-  buildProgram(dc.context, dc.info.device, {"generate.cl"}, options, &first);
+  buildProgram(dc.context, dc.info.device, {"camera_rays.cl"}, options, &first);
   test::writeFile(first.cacheFile, "not a binary");
-  buildProgram(dc.context, dc.info.device, {"generate.cl"}, options, &second);
+  buildProgram(dc.context, dc.info.device, {"camera_rays.cl"}, options, &second);
   EXPECT_FALSE(second.fromCache);
 }
 
 TEST_F(ProgramOnDevice, MissingKernelNameIsAnError) {
-  const cl::Program program = buildProgram(dc.context, dc.info.device, {"generate.cl"}, "");
+  const cl::Program program = buildProgram(dc.context, dc.info.device, {"camera_rays.cl"}, "");
   try {
     createKernel(program, "no_such_kernel");
     FAIL();

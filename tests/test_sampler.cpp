@@ -19,7 +19,8 @@ const char* kTestKernels = R"CL(
 __kernel void draw(uint seed, uint pixel_count, uint dimension, uint one_d, __global float2* out) {
   const uint i = get_global_id(0);
   const PixelSampler s = pixel_sampler(seed, i, pixel_count);
-  out[i] = one_d ? (float2)(sample_1d(&s, dimension), 0.0f) : sample_2d(&s, dimension);
+  const lvec2 u = sample_2d(&s, dimension);
+  out[i] = one_d ? (float2)(sample_1d(&s, dimension), 0.0f) : (float2)(u.x, u.y);
 }
 )CL";
 

@@ -6,13 +6,21 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <vector>
 
+#include "cli/flags.h"
 #include "image/image_io.h"
 
 namespace fh::test {
+
+RenderSettings renderSettings() {
+  RenderSettings s;
+  if (const char* strategy = std::getenv("FREDHOLM_TEST_STRATEGY")) s.strategy = parseStrategy(strategy);
+  return s;
+}
 namespace fs = std::filesystem;
 
 bool haveSharedScenes() { return fs::is_directory(FREDHOLM_SHARED_SCENES); }

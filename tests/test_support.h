@@ -5,7 +5,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "render/settings.h"
+
 namespace fh::test {
+
+// RenderSettings{} with the strategy this run tests: FREDHOLM_TEST_STRATEGY (scalar or
+// simd8; CTest runs every rendering suite under each, tests/CMakeLists.txt), else auto.
+RenderSettings renderSettings();
 
 // Absolute path of a file in ../shared/scenes, or "" if the corpus is absent.
 std::string sharedScene(const std::string& relative);

@@ -6,7 +6,7 @@
 namespace fh {
 
 ProgramSpec benchRaysProgram(const std::string& traversalOptions) {
-  return {"bench rays", {"generate.cl", "bench_rays.cl"}, traversalOptions};
+  return {"bench rays", {"camera_rays.cl", "bench_rays.cl"}, traversalOptions};
 }
 
 RayWorkload::RayWorkload(DeviceContext& dc, const Scene& scene, const Bvh& bvh, RayCaster& caster)

@@ -16,7 +16,7 @@ struct RenderOptions {
   int width = 512, height = 512;
   std::optional<int> spp;  // unset: 64 (4 for --aov), or as many as --time allows
   double seconds = 0.0;
-  std::string method = "mis", filter = "box", env, statsFile;
+  std::string method = "mis", filter = "box", env, statsFile, strategy = "auto";
   int maxDepth = 64;
   std::optional<size_t> wavefront;  // unset: chosen for each device
   bool allFeatures = false;

@@ -16,6 +16,13 @@ Method parseMethod(const std::string& name) {
   throw Error("--method '" + name + "': unknown method (use pt, nee or mis)");
 }
 
+Strategy parseStrategy(const std::string& name) {
+  if (name == "auto") return Strategy::Auto;
+  if (name == "scalar") return Strategy::Scalar;
+  if (name == "simd8") return Strategy::Simd8;
+  throw Error("--strategy '" + name + "': unknown strategy (use auto, scalar or simd8)");
+}
+
 PixelFilter parseFilter(const std::string& name) {
   if (name == "box") return PixelFilter::Box;
   if (name == "gaussian") return PixelFilter::Gaussian;

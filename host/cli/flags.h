@@ -9,6 +9,7 @@
 namespace fh {
 
 Method parseMethod(const std::string& name);      // --method pt|nee|mis
+Strategy parseStrategy(const std::string& name);  // --strategy auto|scalar|simd8
 PixelFilter parseFilter(const std::string& name);  // --filter box|gaussian|blackman-harris
 Aov parseAov(const std::string& name);             // --aov albedo|normal|depth
 // "x,y,z": three finite numbers (--eye, --target, --up, --env).

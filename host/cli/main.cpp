@@ -44,6 +44,10 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
       ->capture_default_str();
   rendering->add_option("--wavefront", o.wavefront, "Paths in flight (default: chosen for the device)");
   rendering->add_option("--stats", o.statsFile, "Write render statistics as JSON");
+  rendering->add_option("--strategy", o.strategy,
+                        "How devices run the stages: auto (by device type), scalar (one path per work-item, for "
+                        "GPUs) or simd8 (eight paths per work-item in vector lanes, for CPUs)")
+      ->capture_default_str();
   rendering->add_flag("--all-features", o.allFeatures,
                       "Compile every material feature, not only the scene's (to measure specialization)");
   rendering->add_option("--seed", o.seed, "Random seed")->capture_default_str();

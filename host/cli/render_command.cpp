@@ -62,6 +62,7 @@ Camera chooseCamera(const RenderOptions& o, const Scene& scene) {
 RenderSettings settingsFrom(const RenderOptions& o) {
   RenderSettings s;
   s.method = parseMethod(o.method);
+  s.strategy = parseStrategy(o.strategy);
   s.filter = parseFilter(o.filter);
   if (!o.env.empty()) s.env = parseVec3Flag("--env", o.env);
   if (s.env[0] < 0 || s.env[1] < 0 || s.env[2] < 0) throw Error("--env '" + o.env + "': radiance cannot be negative");
@@ -107,7 +108,10 @@ RenderResult renderDebugView(Aov mode, const std::vector<DeviceInfo>& devices, c
     r.film.sum[4 * p + 3] = 1.0;
   }
   r.stats.samples = uint64_t(s.spp) * r.film.pixels();
-  r.stats.devices.push_back({devices[0].name, r.stats.samples, 0, 0.0, 0.0, ""});
+  RenderStats::DeviceShare share;
+  share.name = devices[0].name;
+  share.samples = r.stats.samples;
+  r.stats.devices.push_back(share);
   r.stopped = s.stopRequested();  // a debug view finishes once started
   return r;
 }

@@ -143,16 +143,13 @@ DeviceScene::DeviceScene(DeviceContext& dc, const Scene& scene, const Bvh& hostB
 
   // Per-corner normals and UVs in BVH order, only where the scene uses them.
   // A kernel compiled with a feature the scene lacks (--all-features) gets neutral data:
-  // geometric normals, zero UVs.
+  // zero normals, which the kernels read as "the geometric normal" exactly (a normal computed
+  // here would differ from the kernel's in rounding, and so sample other directions), and
+  // zero UVs.
   std::vector<float> cornerNormals, cornerUVs;
   if (f.shadingNormals) {
     std::vector<float> source = scene.cornerNormals;
-    if (source.empty()) {
-      for (size_t t = 0; t < scene.triangleCount(); ++t) {
-        const Vec3f n = cross(scene.corner(t, 1) - scene.corner(t, 0), scene.corner(t, 2) - scene.corner(t, 0));
-        for (int k = 0; k < 3; ++k) source.insert(source.end(), n.begin(), n.end());
-      }
-    }
+    if (source.empty()) source.assign(9 * scene.triangleCount(), 0.f);
     const std::vector<float> ordered = toBvhOrder(source, hostBvh.order, 9);
     for (size_t i = 0; i < ordered.size(); i += 3)
       cornerNormals.insert(cornerNormals.end(), {ordered[i], ordered[i + 1], ordered[i + 2], 0.f});

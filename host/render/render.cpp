@@ -88,6 +88,7 @@ class Render {
       perDevice.progress = false;  // the pool shows the render's progress
       WavefrontPipeline pipeline(dc, scene_, bvh_, camera_, perDevice);
       share.wavefront = pipeline.wavefront();
+      share.strategy = strategyName(pipeline.strategy());
       warnings_[i] = pipeline.sceneWarnings();
       started = true;
       startLine_.arrive();

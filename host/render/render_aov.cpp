@@ -5,7 +5,7 @@
 
 namespace fh {
 
-ProgramSpec aovProgram() { return {"aov", {"generate.cl", "aov.cl"}, ""}; }
+ProgramSpec aovProgram() { return {"aov", {"camera_rays.cl", "aov.cl"}, ""}; }
 
 Image renderAov(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const Camera& camera, const AovSettings& s) {
   RayCaster caster(dc, bvh);

@@ -14,6 +14,7 @@ nlohmann::json devicesJson(const RenderStats& st) {
                             {"samples_per_second", d.busySeconds > 0 ? double(d.samples) / d.busySeconds : 0.0},
                             {"share", st.samples ? double(d.samples) / double(st.samples) : 0.0},
                             {"wavefront", d.wavefront},
+                            {"strategy", d.strategy},
                             {"busy_seconds", d.busySeconds},
                             {"idle_seconds", d.idleSeconds}};
     if (!d.error.empty()) entry["error"] = d.error;

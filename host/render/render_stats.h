@@ -16,6 +16,7 @@ struct RenderStats {
     std::string name;
     uint64_t samples = 0;
     size_t wavefront = 0;
+    std::string strategy;  // how the device ran the stages (settings.h)
     double busySeconds = 0.0, idleSeconds = 0.0;
     std::string error;  // why the device stopped early, if it did
   };

@@ -15,6 +15,12 @@ const char* methodName(Method m);
 enum class PixelFilter { Box, Gaussian, BlackmanHarris };
 const char* filterName(PixelFilter f);
 
+// How a device runs the stages: one path per work-item (GPUs: wide global queues) or eight
+// paths per work-item in vector lanes (CPUs: PoCL does not vectorize divergent shading
+// across work-items, kernels/lanes.h). Both compute the same estimator.
+enum class Strategy { Auto, Scalar, Simd8 };
+const char* strategyName(Strategy s);
+
 struct RenderSettings {
   int width = 512, height = 512;
   int spp = 64;          // samples per pixel; with seconds > 0, the most to take
@@ -28,6 +34,7 @@ struct RenderSettings {
   size_t wavefront = 0;  // paths in flight per device; 0: chosen for each device
   bool progress = false;
   bool allFeatures = false;  // compile every material feature, not only the scene's (benchmarks)
+  Strategy strategy = Strategy::Auto;  // Auto: chosen per device type
   // Set (non-zero) to stop early, as Ctrl-C does: passes in flight are dropped, those
   // finished are kept. Null: never.
   const std::atomic<int>* stop = nullptr;

@@ -59,12 +59,21 @@ gpu::RenderParams renderParams(const RenderSettings& s, const Camera& camera, un
 }  // namespace
 
 ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsigned passSlots,
-                              const std::string& traversalOptions) {
+                              const std::string& traversalOptions, Strategy strategy) {
   const char* methodFlag = method == Method::PT ? "PT" : method == Method::NEE ? "NEE" : "MIS";
-  return {std::string("path tracer (") + methodName(method) + features.buildOptions() + ")", stageFiles(),
+  return {std::string("path tracer (") + methodName(method) + features.buildOptions() + ", " + strategyName(strategy) +
+              ")",
+          stageFiles(),
           traversalOptions + features.buildOptions() + " -DFH_PASS_SLOTS=" + std::to_string(passSlots) +
-              " -DFH_METHOD_" + methodFlag};
+              " -DFH_METHOD_" + methodFlag + " -DFH_LANES=" + std::to_string(lanesOf(strategy))};
 }
+
+Strategy strategyFor(const DeviceInfo& device, Strategy asked) {
+  if (asked != Strategy::Auto) return asked;
+  return device.type == "cpu" ? Strategy::Simd8 : Strategy::Scalar;
+}
+
+unsigned lanesOf(Strategy s) { return s == Strategy::Simd8 ? 8 : 1; }
 
 size_t defaultWavefront(const DeviceInfo& device, size_t pixels) {
   // GPU: the best of the H200 sweep in bench/RESULTS.md (issue 12); larger wavefronts ran emptier.
@@ -76,6 +85,7 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
                                      const RenderSettings& s)
     : dc_(dc),
       method_(s.method),
+      strategy_(strategyFor(dc.info, s.strategy)),
       scene_(dc, scene, bvh, s.allFeatures ? SceneFeatures::all() : sceneFeatures(scene)),
       pixels_(unsigned(s.width) * unsigned(s.height)) {
   // No more paths than the passes in flight can ever hold.
@@ -94,7 +104,8 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
   passTable_.assign(maxPasses, 0);
 
   const cl::Program program = buildProgram(
-      dc.context, dc.info.device, pathTracerProgram(scene_.features, s.method, passSlots_, scene_.bvh.traversalOptions()));
+      dc.context, dc.info.device, pathTracerProgram(scene_.features, s.method, passSlots_, scene_.bvh.traversalOptions(),
+                                                         strategy_));
   for (auto& kernels : kernels_)
     for (size_t i = 0; i < kStages.size(); ++i) kernels[i] = createKernel(program, kStages[i].kernel);
   allocateBuffers(filterTable);

@@ -41,9 +41,16 @@ struct SlotQueues {
   cl::Buffer finished, freeSlots, counters;
 };
 
-// The path tracer's program for a scene's features, a method and the passes in flight.
+// The path tracer's program for a scene's features, a method, the passes in flight and a
+// strategy (Scalar or Simd8: the paths each work-item carries, FH_LANES).
 ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsigned passSlots,
-                              const std::string& traversalOptions);
+                              const std::string& traversalOptions, Strategy strategy);
+
+// The strategy a device runs: the one asked for, or for Auto, eight lanes on a CPU and
+// one path per work-item elsewhere.
+Strategy strategyFor(const DeviceInfo& device, Strategy asked);
+// Paths per work-item in the stages written with lanes (all but intersect and the books).
+unsigned lanesOf(Strategy s);
 
 // The default number of paths in flight: 512k on a GPU, fewer on a CPU, where the
 // path state should stay near the caches; never more than two passes of pixels.
@@ -76,17 +83,20 @@ class WavefrontPipeline {
   // This device's counts so far (samples are the film's to count) and stage times.
   RenderStats stats();
   size_t wavefront() const { return wavefront_; }
+  Strategy strategy() const { return strategy_; }
   // What uploading the scene found (textures that could not be read).
   const std::vector<std::string>& sceneWarnings() const { return scene_.warnings; }
 
  private:
   // The stages; each launches its kernel, bound for the current parity.
   void planIteration() { run(Stage::PlanIteration, 1); }
-  void generate() { run(Stage::Generate, wavefront_); }
+  // Stages with lanes take lanesOf(strategy_) paths per work-item; intersect one ray each.
+  void generate() { run(Stage::Generate, laneItems()); }
   void intersect() { run(Stage::Intersect, wavefront_); }
-  void shade() { run(Stage::Shade, wavefront_); }
-  void shadowConnect() { run(Stage::ShadowConnect, wavefront_); }
-  void accumulate() { run(Stage::Accumulate, wavefront_); }
+  void shade() { run(Stage::Shade, laneItems()); }
+  void shadowConnect() { run(Stage::ShadowConnect, laneItems()); }
+  void accumulate() { run(Stage::Accumulate, laneItems()); }
+  size_t laneItems() const { return (wavefront_ + lanesOf(strategy_) - 1) / lanesOf(strategy_); }
   void finishIteration() { run(Stage::FinishIteration, 1); }
   void run(Stage stage, size_t items);
 
@@ -96,6 +106,7 @@ class WavefrontPipeline {
 
   DeviceContext& dc_;
   Method method_;
+  Strategy strategy_;
   DeviceScene scene_;
   gpu::RenderParams params_{};
   size_t wavefront_;

@@ -1,0 +1,188 @@
+// Lanes: the shading code is written once for FH_LANES paths per work-item.
+//
+// With FH_LANES 1 (GPUs, and every program but the CPU path tracer) an `lfloat` is a float
+// and the code is ordinary scalar code: a mask is an int, `lanes_any(m)` is `m`, and a
+// branch on it is a branch. With FH_LANES 8 (the CPU strategy) an `lfloat` is a float8:
+// each work-item carries eight paths in the lanes of vector registers, branches become
+// selects over the lanes (taken when any lane needs them) and loads of per-path or
+// per-triangle data are gathers. PoCL does not vectorize divergent shading code across
+// work-items on its own (../shared/POCL.md, bench/RESULTS.md), so the lanes are explicit.
+//
+// Masks are what comparisons return: 0 / 1 for scalars, 0 / -1 for vectors; `select`,
+// `&&`, `||`, `!`, `&` and `|` treat both alike. Vectors are lvec3 structures of lanes
+// (x, y, z), not float3, so that each component is one register.
+#ifndef FH_LANES_H
+#define FH_LANES_H
+
+#include "types.h"
+
+#ifndef FH_LANES
+#define FH_LANES 1
+#endif
+
+#if FH_LANES == 1
+typedef float lfloat;
+typedef int lint;
+typedef uint luint;
+typedef int lmask;
+#define lanes_any(m) ((m) != 0)
+#define lanes_all(m) ((m) != 0)
+// Lane l of v, to read or assign.
+#define LANE(v, l) (v)
+#define lconvert_float(x) convert_float(x)
+#define lconvert_uint(x) convert_uint(x)
+#define lconvert_int(x) convert_int(x)
+#define las_int(x) as_int(x)
+#define las_uint(x) as_uint(x)
+#define las_float(x) as_float(x)
+#elif FH_LANES == 8
+typedef float8 lfloat;
+typedef int8 lint;
+typedef uint8 luint;
+typedef int8 lmask;
+#define lanes_any(m) any(m)
+#define lanes_all(m) all(m)
+#define LANE(v, l) ((v)[l])
+#define lconvert_float(x) convert_float8(x)
+#define lconvert_uint(x) convert_uint8(x)
+#define lconvert_int(x) convert_int8(x)
+#define las_int(x) as_int8(x)
+#define las_uint(x) as_uint8(x)
+#define las_float(x) as_float8(x)
+#else
+#error "FH_LANES must be 1 or 8"
+#endif
+
+// A loop over the lanes, unrolled: each LANE(v, l) then names a fixed lane (a register
+// insert or extract) rather than an element of a vector in memory.
+#define FH_FOR_LANES(l) _Pragma("unroll") for (int l = 0; l < FH_LANES; ++l)
+
+// ---- Two- and three-component vectors of lanes ----
+
+typedef struct {
+  lfloat x, y;
+} lvec2;
+
+FH_INLINE lvec2 lv2(lfloat x, lfloat y) {
+  lvec2 v;
+  v.x = x;
+  v.y = y;
+  return v;
+}
+
+typedef struct {
+  lfloat x, y, z;
+} lvec3;
+
+FH_INLINE lvec3 v3(lfloat x, lfloat y, lfloat z) {
+  lvec3 v;
+  v.x = x;
+  v.y = y;
+  v.z = z;
+  return v;
+}
+FH_INLINE lvec3 v3_splat(lfloat s) { return v3(s, s, s); }
+// One value for every lane.
+FH_INLINE lvec3 v3_uniform(float3 u) { return v3((lfloat)(u.x), (lfloat)(u.y), (lfloat)(u.z)); }
+FH_INLINE lvec3 v3_add(lvec3 a, lvec3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+FH_INLINE lvec3 v3_sub(lvec3 a, lvec3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+FH_INLINE lvec3 v3_mul(lvec3 a, lvec3 b) { return v3(a.x * b.x, a.y * b.y, a.z * b.z); }
+FH_INLINE lvec3 v3_scale(lvec3 a, lfloat s) { return v3(a.x * s, a.y * s, a.z * s); }
+FH_INLINE lvec3 v3_neg(lvec3 a) { return v3(-a.x, -a.y, -a.z); }
+// a * s + b
+FH_INLINE lvec3 v3_madd(lvec3 a, lfloat s, lvec3 b) { return v3(a.x * s + b.x, a.y * s + b.y, a.z * s + b.z); }
+FH_INLINE lfloat v3_dot(lvec3 a, lvec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+FH_INLINE lvec3 v3_cross(lvec3 a, lvec3 b) {
+  return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+FH_INLINE lfloat v3_length(lvec3 a) { return sqrt(v3_dot(a, a)); }
+FH_INLINE lvec3 v3_normalize(lvec3 a) { return v3_scale(a, rsqrt(v3_dot(a, a))); }
+FH_INLINE lvec3 v3_abs(lvec3 a) { return v3(fabs(a.x), fabs(a.y), fabs(a.z)); }
+FH_INLINE lvec3 v3_max(lvec3 a, lvec3 b) { return v3(fmax(a.x, b.x), fmax(a.y, b.y), fmax(a.z, b.z)); }
+FH_INLINE lvec3 v3_clamp01(lvec3 a) { return v3(clamp(a.x, 0.0f, 1.0f), clamp(a.y, 0.0f, 1.0f), clamp(a.z, 0.0f, 1.0f)); }
+FH_INLINE lfloat v3_max_component(lvec3 a) { return fmax(fmax(a.x, a.y), a.z); }
+// A mask of every lane (true) or none.
+FH_INLINE lmask lanes_mask(bool all) { return (lint)(all ? 1 : 0) != 0; }
+// Lanes where any component is positive.
+FH_INLINE lmask v3_any_positive(lvec3 a) { return a.x > 0.0f || a.y > 0.0f || a.z > 0.0f; }
+// Lanes of `if_true` where m is set, of `if_false` elsewhere.
+FH_INLINE lvec3 v3_select(lmask m, lvec3 if_true, lvec3 if_false) {
+  return v3(select(if_false.x, if_true.x, m), select(if_false.y, if_true.y, m), select(if_false.z, if_true.z, m));
+}
+FH_INLINE lfloat f_select(lmask m, lfloat if_true, lfloat if_false) { return select(if_false, if_true, m); }
+
+// ---- Gathers and scatters: per-path and per-triangle data by index ----
+
+FH_INLINE lfloat gather_float(__global const float* base, luint index) {
+  lfloat r;
+  FH_FOR_LANES(l) LANE(r, l) = base[LANE(index, l)];
+  return r;
+}
+FH_INLINE luint gather_uint(__global const uint* base, luint index) {
+  luint r;
+  FH_FOR_LANES(l) LANE(r, l) = base[LANE(index, l)];
+  return r;
+}
+FH_INLINE lint gather_int(__global const int* base, luint index) {
+  lint r;
+  FH_FOR_LANES(l) LANE(r, l) = base[LANE(index, l)];
+  return r;
+}
+// The xyz of float4 elements.
+FH_INLINE lvec3 gather_xyz(__global const float4* base, luint index) {
+  lvec3 r;
+  FH_FOR_LANES(l) {
+    const float4 e = base[LANE(index, l)];
+    LANE(r.x, l) = e.x;
+    LANE(r.y, l) = e.y;
+    LANE(r.z, l) = e.z;
+  }
+  return r;
+}
+FH_INLINE lvec2 gather_xy(__global const float2* base, luint index) {
+  lvec2 r;
+  FH_FOR_LANES(l) {
+    const float2 e = base[LANE(index, l)];
+    LANE(r.x, l) = e.x;
+    LANE(r.y, l) = e.y;
+  }
+  return r;
+}
+// The w of float4 elements.
+FH_INLINE lfloat gather_w(__global const float4* base, luint index) {
+  lfloat r;
+  FH_FOR_LANES(l) LANE(r, l) = base[LANE(index, l)].w;
+  return r;
+}
+// Where m is set: base[index] = (v, w).
+FH_INLINE void scatter_xyzw(__global float4* base, luint index, lvec3 v, lfloat w, lmask m) {
+  FH_FOR_LANES(l)
+    if (LANE(m, l)) base[LANE(index, l)] = (float4)(LANE(v.x, l), LANE(v.y, l), LANE(v.z, l), LANE(w, l));
+}
+FH_INLINE void scatter_float(__global float* base, luint index, lfloat v, lmask m) {
+  FH_FOR_LANES(l)
+    if (LANE(m, l)) base[LANE(index, l)] = LANE(v, l);
+}
+FH_INLINE void scatter_uint(__global uint* base, luint index, luint v, lmask m) {
+  FH_FOR_LANES(l)
+    if (LANE(m, l)) base[LANE(index, l)] = LANE(v, l);
+}
+FH_INLINE void scatter_int(__global int* base, luint index, lint v, lmask m) {
+  FH_FOR_LANES(l)
+    if (LANE(m, l)) base[LANE(index, l)] = LANE(v, l);
+}
+
+// Lane l of v as a float3 (for scalar code: ray traversal).
+FH_INLINE float3 v3_lane(lvec3 v, int l) { return (float3)(LANE(v.x, l), LANE(v.y, l), LANE(v.z, l)); }
+
+// The queue positions this work-item's lanes start at: lane l of the result is
+// first + l, the paths a work-item of the CPU strategy carries.
+FH_INLINE luint lane_positions(uint first) {
+#if FH_LANES == 1
+  return first;
+#else
+  return (luint)(first) + (luint)(0, 1, 2, 3, 4, 5, 6, 7);
+#endif
+}
+
+#endif
