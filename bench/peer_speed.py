@@ -3,12 +3,12 @@
 drifts by tens of percent between runs, so only interleaved figures compare).
 
   bench/peer_speed.py [--rounds 3] [--spp 64] [--mitsuba-python /opt/mi-venv/bin/python]
-                      [--strategies simd8,scalar] [--fredholm build/fredholm]
+                      [--strategies simd8,scalar] [--fredholm build/fredholm] [--baseline OLD]
 
 Each round renders the Cornell box at 512x512 with at most 16 bounces (the camera of the
 issue: eye 0,1,3.5, target 0,1,0, fov 40) with fredholm `mis` under each strategy and with
 Mitsuba's llvm_ad_rgb variant (../shared/peers/mitsuba/cbox.py), the order rotated every
-round, and prints each renderer's Msamples/s per round and median. The first render of
+round (and, with --baseline, an older fredholm binary without --strategy), and prints each renderer's Msamples/s per round and median. The first render of
 each is a warm-up (kernel compilation, Mitsuba's JIT) and is not counted.
 """
 import argparse, json, os, statistics, subprocess, tempfile
@@ -18,9 +18,10 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 def fredholm(binary, strategy, spp, workdir):
     stats = os.path.join(workdir, "s.json")
+    choice = ["--strategy", strategy] if strategy else []
     subprocess.run([binary, "render", "--width", "512", "--height", "512", "--spp", str(spp), "--method", "mis",
                     "--eye", "0,1,3.5", "--target", "0,1,0", "--fov", "40", "--max-depth", "16",
-                    "--strategy", strategy, "-o", os.path.join(workdir, "f.pfm"), "--force", "--stats", stats],
+                    ] + choice + ["-o", os.path.join(workdir, "f.pfm"), "--force", "--stats", stats],
                    check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     with open(stats) as f:
         return json.load(f)["samples_per_second"] / 1e6
@@ -42,9 +43,12 @@ def main():
     ap.add_argument("--mitsuba-python", default="/opt/mi-venv/bin/python")
     ap.add_argument("--strategies", default="simd8,scalar")
     ap.add_argument("--fredholm", default=os.path.join(ROOT, "build", "fredholm"))
+    ap.add_argument("--baseline", help="an older fredholm binary (run without --strategy)")
     opts = ap.parse_args()
     runners = {"fredholm mis " + s: (lambda s=s, w=None: fredholm(opts.fredholm, s, opts.spp, w))
                for s in opts.strategies.split(",")}
+    if opts.baseline:
+        runners["fredholm mis baseline"] = lambda w=None: fredholm(opts.baseline, None, opts.spp, w)
     runners["mitsuba llvm_ad_rgb"] = lambda w=None: mitsuba(opts.mitsuba_python, opts.spp, w)
     names = list(runners)
     results = {n: [] for n in names}

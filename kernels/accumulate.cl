@@ -31,7 +31,7 @@ __kernel void accumulate(__global const uint* finished_queue, volatile __global 
       if (!LANE(finite, l)) atomic_inc(&counters->nonfinite);
     }
   }
-  // One global atomic per pass slot and work-group (see queue_append).
+  // One global atomic per pass slot and work-group (see queue_append_each).
   barrier(CLK_LOCAL_MEM_FENCE);
   if (lid < FH_PASS_SLOTS && finished_in_slot[lid]) atomic_add(&counters->pass_done[lid], finished_in_slot[lid]);
 }

@@ -43,7 +43,7 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
                     __global const GpuMaterial* materials, __global const float* light_pdf_area,
                     __global const float4* normals, __global const float2* uvs, __global const float4* texels,
                     __global const uint4* texture_info FH_PATH_PARAMS FH_SHADOW_PARAMS) {
-  volatile __local uint scratch[2];
+  volatile __local uint scratch[2 * 3];
   const luint position = lane_positions(get_global_id(0) * FH_LANES);
   const lmask active = position < counters->ray_length[parity];
   luint p = (luint)(0);
@@ -135,8 +135,15 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
     scatter_xyzw(radiance, p, gathered, (lfloat)(0.0f), active);
   }
 
-  queue_append(continues, p, next_queue, &counters->ray_length[1 - parity], scratch);
-  const luint request = queue_append(light_sample, p, shadow_path, &counters->shadow_length, scratch);
+  // Continuing paths to the next ray queue, light-sample requests to shadow_connect's,
+  // finished paths to accumulate's.
+  const lmask append[3] = {continues, light_sample, active && !continues};
+  __global uint* const queues[3] = {next_queue, shadow_path, finished_queue};
+  volatile __global uint* const lengths[3] = {&counters->ray_length[1 - parity], &counters->shadow_length,
+                                              &counters->finished_length};
+  luint positions[3];
+  queue_append_each(3, append, p, queues, lengths, scratch, positions);
+  const luint request = positions[1];
   if (lanes_any(light_sample)) {
     scatter_xyzw(shadow_position, request, s.position, s.magnitude, light_sample);
     scatter_xyzw(shadow_normal, request, n, (lfloat)(0.0f), light_sample);
@@ -147,5 +154,4 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
     scatter_int(shadow_material, request, material_id, light_sample);
     scatter_uint(shadow_depth, request, bounce, light_sample);
   }
-  queue_append(active && !continues, p, finished_queue, &counters->finished_length, scratch);
 }

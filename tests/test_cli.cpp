@@ -38,6 +38,9 @@ TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
       {"--spp 0", "--spp must be at least 1"},
       {"--wavefront 0", "--wavefront must be at least 64"},
       {"--spp 1 --spp 2", "fredholm: error: --spp"},
+      // Issue 13: the strategy and roulette flags.
+      {"--strategy vector", "--strategy 'vector': unknown strategy (use auto, scalar or simd8)"},
+      {"--rr-depth 0", "--rr-depth must be at least 1"},
   };
   for (const auto& [flags, message] : cases) {
     const auto r = test::runFredholm(std::string("render ") + flags + " -o " + dir + "/x.png");
@@ -58,6 +61,11 @@ TEST(RenderCli, StatsAndExrMetadata) {
   EXPECT_EQ(stats["nonfinite_samples"], 0);
   EXPECT_GT(stats["samples_per_second"].get<double>(), 0.0);
   EXPECT_EQ(stats["devices"].size(), 1u);
+  EXPECT_EQ(stats["rr_depth"], 3);
+  // On a CPU the automatic strategy is eight paths per work-item.
+  if (stats["devices"][0]["name"].get<std::string>().find("pthread") != std::string::npos) {
+    EXPECT_EQ(stats["devices"][0]["strategy"], "simd8");
+  }
   EXPECT_EQ(stats["method"], "nee");
   for (const char* kernel : {"generate", "intersect", "shade", "shadow_connect", "accumulate"})
     EXPECT_TRUE(stats["kernels"].contains(kernel)) << kernel;

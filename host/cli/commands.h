@@ -18,6 +18,7 @@ struct RenderOptions {
   double seconds = 0.0;
   std::string method = "mis", filter = "box", env, statsFile, strategy = "auto";
   int maxDepth = 64;
+  int rrDepth = 3;
   std::optional<size_t> wavefront;  // unset: chosen for each device
   bool allFeatures = false;
   unsigned seed = 1;

@@ -39,6 +39,10 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
       ->capture_default_str();
   rendering->add_option("--max-depth", o.maxDepth, "Most bounces (Russian roulette ends most paths sooner)")
       ->capture_default_str();
+  rendering->add_option("--rr-depth", o.rrDepth,
+                        "Russian roulette decides whether paths go on from this bounce on (Mitsuba's rr_depth 5 "
+                        "is 6 here)")
+      ->capture_default_str();
   rendering->add_option("--env", o.env, "Constant environment radiance R,G,B (default black)");
   rendering->add_option("--filter", o.filter, "Pixel filter: box, gaussian or blackman-harris")
       ->capture_default_str();

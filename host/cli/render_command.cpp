@@ -74,6 +74,7 @@ RenderSettings settingsFrom(const RenderOptions& o) {
   if (o.spp && *o.spp < 1) throw Error("--spp must be at least 1");
   if (!std::isfinite(o.seconds) || o.seconds < 0) throw Error("--time must be a finite number of seconds");
   if (o.maxDepth < 1) throw Error("--max-depth must be at least 1");
+  if (o.rrDepth < 1) throw Error("--rr-depth must be at least 1");
   if (o.wavefront && *o.wavefront < kLocalSize) throw Error("--wavefront must be at least 64");
   const uint64_t pixels = uint64_t(o.width) * uint64_t(o.height);
   s.width = o.width;
@@ -83,6 +84,7 @@ RenderSettings settingsFrom(const RenderOptions& o) {
                                  : (o.aov.empty() ? 64 : 4));
   s.seconds = o.seconds;
   s.maxDepth = o.maxDepth;
+  s.rrDepth = o.rrDepth;
   s.seed = o.seed;
   s.wavefront = o.wavefront.value_or(0);
   s.allFeatures = o.allFeatures;

@@ -63,6 +63,7 @@ std::string statsJson(const RenderStats& st, const RenderSettings& s) {
       {"spp", s.width * s.height > 0 ? double(st.samples) / (double(s.width) * s.height) : 0.0},
       {"seed", s.seed},
       {"max_depth", s.maxDepth},
+      {"rr_depth", s.rrDepth},
       {"filter", filterName(s.filter)},
       {"wavefront", st.wavefront},
       {"iterations", st.iterations},

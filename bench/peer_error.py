@@ -1,0 +1,95 @@
+#!/usr/bin/python3
+"""Error against time on the Cornell box at 512x512 (at most 16 bounces, the issue's camera):
+fredholm's methods and Mitsuba 3 (llvm_ad_rgb, ldsampler and independent samplers) on the
+same axes, each image measured against one long reference with Mitsuba's compare.py
+(relMSE with epsilon 1e-2, the reference box-downsampled if larger).
+
+  bench/peer_error.py --ref REF.exr [--spp 4,16,64,256] [--methods mis,nee,pt]
+                      [--mitsuba-python /opt/mi-venv/bin/python] [--out bench/peers]
+                      [-- EXTRA fredholm render flags]
+
+Renders run one after another (never two at once): fredholm's seconds are --stats
+`seconds` (devices ready to last pass merged), Mitsuba's `seconds_render` (after its JIT
+warm-up). Writes OUT/cornell-peers.csv and OUT/cornell-peers.png (log-log, with a slope -1
+guide: an unbiased estimator's relMSE falls as 1/time).
+"""
+import argparse, csv, json, os, subprocess, sys, tempfile
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PEER = os.path.join(ROOT, "..", "shared", "peers", "mitsuba")
+CAMERA = ["--eye", "0,1,3.5", "--target", "0,1,0", "--fov", "40", "--max-depth", "16"]
+
+
+def relmse(python, ref, image):
+    out = subprocess.run([python, os.path.join(PEER, "compare.py"), ref, image], check=True, capture_output=True,
+                         text=True).stdout
+    return json.loads(out.strip().splitlines()[-1])["relMSE"]
+
+
+def fredholm(method, spp, extra, workdir):
+    image, stats = os.path.join(workdir, "f.exr"), os.path.join(workdir, "f.json")
+    subprocess.run([os.path.join(ROOT, "build", "fredholm"), "render", "--width", "512", "--height", "512",
+                    "--spp", str(spp), "--method", method, "--seed", str(spp)] + CAMERA + extra +
+                   ["-o", image, "--force", "--stats", stats], check=True, stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL)
+    with open(stats) as f:
+        return image, json.load(f)["seconds"]
+
+
+def mitsuba(python, sampler, spp, workdir):
+    image = os.path.join(workdir, "m.exr")
+    out = subprocess.run([python, os.path.join(PEER, "cbox.py"), "--variant", "llvm_ad_rgb", "--sampler", sampler,
+                          "--spp", str(spp), "--seed", str(spp), "--max-bounces", "16", "--out", image],
+                         check=True, capture_output=True, text=True).stdout
+    return image, json.loads([l for l in out.splitlines() if l.startswith("{")][-1])["seconds_render"]
+
+
+def main():
+    argv = sys.argv[1:]
+    extra = argv[argv.index("--") + 1:] if "--" in argv else []
+    argv = argv[:argv.index("--")] if "--" in argv else argv
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--ref", required=True)
+    ap.add_argument("--spp", default="4,16,64,256")
+    ap.add_argument("--methods", default="mis,nee,pt")
+    ap.add_argument("--mitsuba-python", default="/opt/mi-venv/bin/python")
+    ap.add_argument("--out", default=os.path.join(ROOT, "bench", "peers"))
+    opts = ap.parse_args(argv)
+    os.makedirs(opts.out, exist_ok=True)
+    rows = []
+    with tempfile.TemporaryDirectory() as workdir:
+        for spp in [int(s) for s in opts.spp.split(",")]:
+            for method in opts.methods.split(","):
+                image, seconds = fredholm(method, spp, extra, workdir)
+                rows.append(("fredholm " + method, spp, seconds, relmse(opts.mitsuba_python, opts.ref, image)))
+                print(*rows[-1], flush=True)
+            for sampler in ("ldsampler", "independent"):
+                image, seconds = mitsuba(opts.mitsuba_python, sampler, spp, workdir)
+                rows.append(("mitsuba " + sampler, spp, seconds, relmse(opts.mitsuba_python, opts.ref, image)))
+                print(*rows[-1], flush=True)
+    with open(os.path.join(opts.out, "cornell-peers.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["renderer", "spp", "seconds", "relmse"])
+        w.writerows(rows)
+    plt.figure(figsize=(6.4, 4.8))
+    for name in dict.fromkeys(r[0] for r in rows):
+        pts = [(r[2], r[3]) for r in rows if r[0] == name]
+        plt.loglog([p[0] for p in pts], [p[1] for p in pts], "o-" if name.startswith("fredholm") else "s--",
+                   label=name)
+    t0, e0 = rows[0][2], rows[0][3]
+    plt.loglog([t0, t0 * 100], [e0, e0 / 100], ":", color="gray", label="slope -1")
+    plt.xlabel("seconds")
+    plt.ylabel("relMSE against the reference")
+    plt.title("Cornell box 512x512, at most 16 bounces")
+    plt.legend(fontsize=8)
+    plt.grid(True, which="both", alpha=0.3)
+    plt.savefig(os.path.join(opts.out, "cornell-peers.png"), dpi=100, bbox_inches="tight")
+
+
+if __name__ == "__main__":
+    main()
