@@ -26,7 +26,6 @@ typedef int lint;
 typedef uint luint;
 typedef int lmask;
 #define lanes_any(m) ((m) != 0)
-#define lanes_all(m) ((m) != 0)
 // Lane l of v, to read or assign.
 #define LANE(v, l) (v)
 #define lconvert_float(x) convert_float(x)
@@ -34,21 +33,18 @@ typedef int lmask;
 #define lconvert_int(x) convert_int(x)
 #define las_int(x) as_int(x)
 #define las_uint(x) as_uint(x)
-#define las_float(x) as_float(x)
 #elif FH_LANES == 8
 typedef float8 lfloat;
 typedef int8 lint;
 typedef uint8 luint;
 typedef int8 lmask;
 #define lanes_any(m) any(m)
-#define lanes_all(m) all(m)
 #define LANE(v, l) ((v)[l])
 #define lconvert_float(x) convert_float8(x)
 #define lconvert_uint(x) convert_uint8(x)
 #define lconvert_int(x) convert_int8(x)
 #define las_int(x) as_int8(x)
 #define las_uint(x) as_uint8(x)
-#define las_float(x) as_float8(x)
 #else
 #error "FH_LANES must be 1 or 8"
 #endif
@@ -109,25 +105,26 @@ FH_INLINE lmask v3_any_positive(lvec3 a) { return a.x > 0.0f || a.y > 0.0f || a.
 FH_INLINE lvec3 v3_select(lmask m, lvec3 if_true, lvec3 if_false) {
   return v3(select(if_false.x, if_true.x, m), select(if_false.y, if_true.y, m), select(if_false.z, if_true.z, m));
 }
-FH_INLINE lfloat f_select(lmask m, lfloat if_true, lfloat if_false) { return select(if_false, if_true, m); }
 
 // ---- Gathers and scatters: per-path and per-triangle data by index ----
 
-FH_INLINE lfloat gather_float(__global const float* base, luint index) {
-  lfloat r;
-  FH_FOR_LANES(l) LANE(r, l) = base[LANE(index, l)];
-  return r;
-}
-FH_INLINE luint gather_uint(__global const uint* base, luint index) {
-  luint r;
-  FH_FOR_LANES(l) LANE(r, l) = base[LANE(index, l)];
-  return r;
-}
-FH_INLINE lint gather_int(__global const int* base, luint index) {
-  lint r;
-  FH_FOR_LANES(l) LANE(r, l) = base[LANE(index, l)];
-  return r;
-}
+// gather_float, gather_uint, gather_int: base[index] for each lane's index, and
+// scatter_float, scatter_uint, scatter_int: base[index] = v where m is set.
+#define FH_GATHER_SCATTER(element, lanes_type)                                                   \
+  FH_INLINE lanes_type gather_##element(__global const element* base, luint index) {            \
+    lanes_type r;                                                                               \
+    FH_FOR_LANES(l) LANE(r, l) = base[LANE(index, l)];                                          \
+    return r;                                                                                   \
+  }                                                                                             \
+  FH_INLINE void scatter_##element(__global element* base, luint index, lanes_type v, lmask m) { \
+    FH_FOR_LANES(l)                                                                             \
+    if (LANE(m, l)) base[LANE(index, l)] = LANE(v, l);                                          \
+  }
+FH_GATHER_SCATTER(float, lfloat)
+FH_GATHER_SCATTER(uint, luint)
+FH_GATHER_SCATTER(int, lint)
+#undef FH_GATHER_SCATTER
+
 // The xyz of float4 elements.
 FH_INLINE lvec3 gather_xyz(__global const float4* base, luint index) {
   lvec3 r;
@@ -158,18 +155,6 @@ FH_INLINE lfloat gather_w(__global const float4* base, luint index) {
 FH_INLINE void scatter_xyzw(__global float4* base, luint index, lvec3 v, lfloat w, lmask m) {
   FH_FOR_LANES(l)
     if (LANE(m, l)) base[LANE(index, l)] = (float4)(LANE(v.x, l), LANE(v.y, l), LANE(v.z, l), LANE(w, l));
-}
-FH_INLINE void scatter_float(__global float* base, luint index, lfloat v, lmask m) {
-  FH_FOR_LANES(l)
-    if (LANE(m, l)) base[LANE(index, l)] = LANE(v, l);
-}
-FH_INLINE void scatter_uint(__global uint* base, luint index, luint v, lmask m) {
-  FH_FOR_LANES(l)
-    if (LANE(m, l)) base[LANE(index, l)] = LANE(v, l);
-}
-FH_INLINE void scatter_int(__global int* base, luint index, lint v, lmask m) {
-  FH_FOR_LANES(l)
-    if (LANE(m, l)) base[LANE(index, l)] = LANE(v, l);
 }
 
 // Lane l of v as a float3 (for scalar code: ray traversal).
