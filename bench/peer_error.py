@@ -9,7 +9,8 @@ same axes, each image measured against one long reference with Mitsuba's compare
                       [-- EXTRA fredholm render flags]
 
 Renders run one after another (never two at once): fredholm's seconds are --stats
-`seconds` (devices ready to last pass merged), Mitsuba's `seconds_render` (after its JIT
+`seconds` (devices ready to last pass merged, after a warm-up render per method has filled
+PoCL's kernel cache), Mitsuba's `seconds_render` (after its JIT
 warm-up). Writes OUT/cornell-peers.csv and OUT/cornell-peers.png (log-log, with a slope -1
 guide: an unbiased estimator's relMSE falls as 1/time).
 """
@@ -63,6 +64,8 @@ def main():
     os.makedirs(opts.out, exist_ok=True)
     rows = []
     with tempfile.TemporaryDirectory() as workdir:
+        for method in opts.methods.split(","):
+            fredholm(method, 1, extra, workdir)  # PoCL compiles a kernel at its first launch: keep that out
         for spp in [int(s) for s in opts.spp.split(",")]:
             for method in opts.methods.split(","):
                 image, seconds = fredholm(method, spp, extra, workdir)

@@ -8,15 +8,20 @@ drifts by tens of percent between runs, so only interleaved figures compare).
 Each round renders the Cornell box at 512x512 with at most 16 bounces (the camera of the
 issue: eye 0,1,3.5, target 0,1,0, fov 40) with fredholm `mis` under each strategy and with
 Mitsuba's llvm_ad_rgb variant (../shared/peers/mitsuba/cbox.py), the order rotated every
-round (and, with --baseline, an older fredholm binary without --strategy), and prints each renderer's Msamples/s per round and median. The first render of
-each is a warm-up (kernel compilation, Mitsuba's JIT) and is not counted.
+round (and, with --baseline, an older fredholm binary without --strategy), and prints each
+renderer's Msamples/s per round and median, then each fredholm kernel's median time per
+sample (--stats "kernels"). The first render of each is a warm-up (kernel compilation,
+Mitsuba's JIT) and is not counted.
 """
 import argparse, json, os, statistics, subprocess, tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-def fredholm(binary, strategy, spp, workdir):
+KERNEL_NS = {}  # runner name -> kernel -> [ns per sample, one per round]
+
+
+def fredholm(binary, strategy, spp, workdir, name=None):
     stats = os.path.join(workdir, "s.json")
     choice = ["--strategy", strategy] if strategy else []
     subprocess.run([binary, "render", "--width", "512", "--height", "512", "--spp", str(spp), "--method", "mis",
@@ -24,7 +29,11 @@ def fredholm(binary, strategy, spp, workdir):
                     ] + choice + ["-o", os.path.join(workdir, "f.pfm"), "--force", "--stats", stats],
                    check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     with open(stats) as f:
-        return json.load(f)["samples_per_second"] / 1e6
+        st = json.load(f)
+    if name:
+        for kernel, k in st.get("kernels", {}).items():
+            KERNEL_NS.setdefault(name, {}).setdefault(kernel, []).append(k["seconds"] / st["samples"] * 1e9)
+    return st["samples_per_second"] / 1e6
 
 
 def mitsuba(python, spp, workdir):
@@ -45,11 +54,11 @@ def main():
     ap.add_argument("--fredholm", default=os.path.join(ROOT, "build", "fredholm"))
     ap.add_argument("--baseline", help="an older fredholm binary (run without --strategy)")
     opts = ap.parse_args()
-    runners = {"fredholm mis " + s: (lambda s=s, w=None: fredholm(opts.fredholm, s, opts.spp, w))
+    runners = {"fredholm mis " + s: (lambda s=s, w=None, n=None: fredholm(opts.fredholm, s, opts.spp, w, n))
                for s in opts.strategies.split(",")}
     if opts.baseline:
-        runners["fredholm mis baseline"] = lambda w=None: fredholm(opts.baseline, None, opts.spp, w)
-    runners["mitsuba llvm_ad_rgb"] = lambda w=None: mitsuba(opts.mitsuba_python, opts.spp, w)
+        runners["fredholm mis baseline"] = lambda w=None, n=None: fredholm(opts.baseline, None, opts.spp, w, n)
+    runners["mitsuba llvm_ad_rgb"] = lambda w=None, n=None: mitsuba(opts.mitsuba_python, opts.spp, w)
     names = list(runners)
     results = {n: [] for n in names}
     with tempfile.TemporaryDirectory() as workdir:
@@ -58,13 +67,16 @@ def main():
         for r in range(opts.rounds):
             order = names[r % len(names):] + names[:r % len(names)]
             for n in order:
-                results[n].append(runners[n](w=workdir))
+                results[n].append(runners[n](w=workdir, n=n))
             print("round %d: " % (r + 1) + ", ".join("%s %.3f" % (n, results[n][-1]) for n in names), flush=True)
     base = statistics.median(results["mitsuba llvm_ad_rgb"])
     for n in names:
         m = statistics.median(results[n])
         print("%-22s median %.3f Msamples/s  (%s)  %.2fx Mitsuba" % (n, m, ", ".join("%.3f" % v for v in results[n]),
                                                                       m / base))
+    for n, kernels in KERNEL_NS.items():
+        print("%-22s ns/sample: %s" % (n, ", ".join("%s %.0f" % (k, statistics.median(v))
+                                                       for k, v in sorted(kernels.items(), key=lambda kv: -max(kv[1])))))
 
 
 if __name__ == "__main__":

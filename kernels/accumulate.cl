@@ -7,6 +7,20 @@
 #include "path_state.h"
 #include "lanes.h"
 
+// Writes the radiance of finished paths p (where `active`) to their pass's buffer, a
+// non-finite value as zero; returns which were finite and sets *pass_slot to their
+// pass-buffer slots.
+FH_INLINE lmask record_samples(luint p, lmask active, uint pixel_count, __global float4* pass_buffer,
+                               luint* pass_slot FH_PATH_PARAMS) {
+  const luint pixel = gather_uint(sample_id, p) % pixel_count, slot = gather_uint(local_pass, p) % FH_PASS_SLOTS;
+  lvec3 value = gather_xyz(radiance, p);
+  const lmask finite = isfinite(value.x) && isfinite(value.y) && isfinite(value.z);
+  value = v3_select(finite, value, v3_splat(0.0f));
+  scatter_xyzw(pass_buffer, slot * pixel_count + pixel, value, (lfloat)(1.0f), active);
+  *pass_slot = slot;
+  return finite;
+}
+
 __kernel void accumulate(__global const uint* finished_queue, volatile __global WavefrontCounters* counters,
                          __global uint* free_list, uint pixel_count, __global float4* pass_buffer FH_PATH_PARAMS) {
   volatile __local uint finished_in_slot[FH_PASS_SLOTS];
@@ -18,11 +32,8 @@ __kernel void accumulate(__global const uint* finished_queue, volatile __global 
   if (lanes_any(active)) {
     const luint i = select((luint)(0), position, active);
     const luint p = gather_uint(finished_queue, i);
-    const luint pixel = gather_uint(sample_id, p) % pixel_count, slot = gather_uint(local_pass, p) % FH_PASS_SLOTS;
-    lvec3 value = gather_xyz(radiance, p);
-    const lmask finite = isfinite(value.x) && isfinite(value.y) && isfinite(value.z);
-    value = v3_select(finite, value, v3_splat(0.0f));
-    scatter_xyzw(pass_buffer, slot * pixel_count + pixel, value, (lfloat)(1.0f), active);
+    luint slot;
+    const lmask finite = record_samples(p, active, pixel_count, pass_buffer, &slot FH_PATH_ARGS);
     scatter_uint(free_list, counters->free_length + i, p, active);
     FH_FOR_LANES(l) {
       if (!LANE(active, l)) continue;

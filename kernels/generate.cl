@@ -6,20 +6,13 @@
 #include "path_state.h"
 #include "sampler.h"
 
-// Starts the planned samples in the slots on top of the free list and appends them to
-// the ray queue. A device numbers its samples locally (j); its passes are granted by the
-// host, which may hand different passes to different devices: local pass j / pixel_count
-// is global pass pass_table[j / pixel_count]. Global sample k = pass * pixel_count + pixel
-// seeds the random numbers, so a sample is the same whichever device renders it.
-__kernel void generate(RenderParams params, __global const WavefrontCounters* counters,
-                       __global const uint* free_list, __global uint* ray_queue, __global const float* filter_table,
-                       __global const uint* pass_table FH_PATH_PARAMS) {
-  const luint position = lane_positions(get_global_id(0) * FH_LANES);
-  const lmask active = position < counters->new_count;
-  if (!lanes_any(active)) return;
-  const luint i = select((luint)(0), position, active);  // idle lanes compute sample 0 and write nothing
-  const luint slot = gather_uint(free_list, counters->new_free_top - 1 - i);
-  const luint j = counters->new_first + i;
+// Starts device sample j (a device numbers its samples locally) in path slot `slot`. Its
+// passes are granted by the host, which may hand different passes to different devices:
+// local pass j / pixel_count is global pass pass_table[j / pixel_count]. Global sample
+// k = pass * pixel_count + pixel seeds the random numbers, so a sample is the same
+// whichever device renders it.
+FH_INLINE void start_sample(RenderParams params, luint j, luint slot, lmask active, __global const float* filter_table,
+                            __global const uint* pass_table FH_PATH_PARAMS) {
   const luint pixel = j % params.pixel_count, device_pass = j / params.pixel_count;
   const luint pass = gather_uint(pass_table, device_pass);
   const luint k = pass * params.pixel_count + pixel;
@@ -36,5 +29,18 @@ __kernel void generate(RenderParams params, __global const WavefrontCounters* co
   scatter_uint(sample_id, slot, k, active);
   scatter_uint(local_pass, slot, device_pass, active);
   scatter_uint(depth, slot, (luint)(0), active);
+}
+
+// Starts the planned samples in the slots on top of the free list and appends them to
+// the ray queue.
+__kernel void generate(RenderParams params, __global const WavefrontCounters* counters,
+                       __global const uint* free_list, __global uint* ray_queue, __global const float* filter_table,
+                       __global const uint* pass_table FH_PATH_PARAMS) {
+  const luint position = lane_positions(get_global_id(0) * FH_LANES);
+  const lmask active = position < counters->new_count;
+  if (!lanes_any(active)) return;
+  const luint i = select((luint)(0), position, active);  // idle lanes compute sample 0 and write nothing
+  const luint slot = gather_uint(free_list, counters->new_free_top - 1 - i);
+  start_sample(params, counters->new_first + i, slot, active, filter_table, pass_table FH_PATH_ARGS);
   scatter_uint(ray_queue, counters->new_queue_base + i, slot, active);
 }

@@ -24,15 +24,20 @@ __kernel void intersect_any(__global const Bvh8Node* nodes, __global const Trian
   occluded[i] = trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w, true).triangle >= 0;
 }
 
+// Closest hit for the ray of path slot p: reads ray_org/ray_dir, writes hit.
+FH_INLINE void intersect_slot(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, uint p,
+                              __global const float4* ray_org, __global const float4* ray_dir, __global float4* hit) {
+  const float4 o = ray_org[p], d = ray_dir[p];
+  const TraceHit h = trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w, false);
+  hit[p] = (float4)(h.triangle < 0 ? INFINITY : h.t, h.b1, h.b2, as_float(h.triangle));
+}
+
 // The intersect stage: closest hit for the paths in the current ray queue (parity picks
-// its length); reads ray_org/ray_dir, writes hit.
+// its length).
 __kernel void intersect(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
                         __global const uint* ray_queue, __global const WavefrontCounters* counters, uint parity,
                         __global const float4* ray_org, __global const float4* ray_dir, __global float4* hit) {
   const uint i = get_global_id(0);
   if (i >= counters->ray_length[parity]) return;
-  const uint p = ray_queue[i];
-  const float4 o = ray_org[p], d = ray_dir[p];
-  const TraceHit h = trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w, false);
-  hit[p] = (float4)(h.triangle < 0 ? INFINITY : h.t, h.b1, h.b2, as_float(h.triangle));
+  intersect_slot(nodes, blocks, ray_queue[i], ray_org, ray_dir, hit);
 }

@@ -5,15 +5,27 @@
 // reads one and fills the other.
 #include "types.h"
 
+// A megakernel launch starts up to this many samples per path slot: each slot takes its
+// next sample where its path ends. More per launch means fewer launches, fewer means
+// passes come back and a stop is seen sooner.
+#define FH_MEGAKERNEL_SAMPLES_PER_SLOT 4
+
 __kernel void plan_iteration(volatile __global WavefrontCounters* counters, uint parity) {
   if (get_global_id(0) != 0) return;
   const uint free_slots = counters->free_length, next = counters->next_sample, limit = counters->sample_limit;
+#if defined(FH_MEGAKERNEL)
+  // Every path a megakernel launch starts ends in it: no rays carry over, and the slots
+  // are all free again (and stay in the free list) when it is done.
+  const uint count = min(FH_MEGAKERNEL_SAMPLES_PER_SLOT * free_slots, limit - min(limit, next));
+  counters->ray_length[parity] = 0;
+#else
   const uint count = min(free_slots, limit - min(limit, next));
+  counters->free_length = free_slots - count;
+#endif
   counters->new_count = count;
   counters->new_first = next;
   counters->new_free_top = free_slots;
   counters->new_queue_base = counters->ray_length[parity];
-  counters->free_length = free_slots - count;
   counters->next_sample = next + count;
   counters->ray_length[parity] += count;
   counters->ray_length[1 - parity] = 0;

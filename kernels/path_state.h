@@ -46,10 +46,55 @@
 #define FH_DIM_PIXEL 0x7fff0000u
 
 #ifdef __OPENCL_VERSION__
+#include "ray.h"
+
 #define FH_PATH_PARAM(type, name, bytes) , __global type* name
-// Appended to a kernel's parameter list: `__kernel void k(int a FH_PATH_PARAMS)`.
+#define FH_PATH_ARG(type, name, bytes) , name
+// Appended to a kernel's or a stage function's parameter list:
+// `__kernel void k(int a FH_PATH_PARAMS)`, and to a call that passes them on: `f(a FH_PATH_ARGS)`.
 #define FH_PATH_PARAMS FH_PATH_FIELDS(FH_PATH_PARAM)
+#define FH_PATH_ARGS FH_PATH_FIELDS(FH_PATH_ARG)
 #define FH_SHADOW_PARAMS FH_SHADOW_FIELDS(FH_PATH_PARAM)
+#define FH_SHADOW_ARGS FH_SHADOW_FIELDS(FH_PATH_ARG)
+
+// One light-sample request per lane, as shade makes it and shadow_connect uses it; the
+// wavefront stores it in the FH_SHADOW_FIELDS buffers between the two, the megakernel
+// hands it over directly.
+typedef struct {
+  luint path;
+  SurfacePoint at;  // at.normal: the geometric normal on the viewer's side
+  lvec3 shading_normal, albedo, throughput, wo;
+  lint material;
+  luint depth;
+} ShadowRequest;
+
+// Every field but the path: shadow_path is the request queue itself, which
+// queue_append_each fills.
+FH_INLINE void store_shadow_request(const ShadowRequest* r, luint index, lmask m FH_SHADOW_PARAMS) {
+  scatter_xyzw(shadow_position, index, r->at.position, r->at.magnitude, m);
+  scatter_xyzw(shadow_normal, index, r->shading_normal, (lfloat)(0.0f), m);
+  scatter_xyzw(shadow_geometric, index, r->at.normal, (lfloat)(0.0f), m);
+  scatter_xyzw(shadow_albedo, index, r->albedo, (lfloat)(0.0f), m);
+  scatter_xyzw(shadow_throughput, index, r->throughput, (lfloat)(0.0f), m);
+  scatter_xyzw(shadow_wo, index, r->wo, (lfloat)(0.0f), m);
+  scatter_int(shadow_material, index, r->material, m);
+  scatter_uint(shadow_depth, index, r->depth, m);
+}
+
+FH_INLINE ShadowRequest load_shadow_request(luint index FH_SHADOW_PARAMS) {
+  ShadowRequest r;
+  r.path = gather_uint(shadow_path, index);
+  r.at.position = gather_xyz(shadow_position, index);
+  r.at.magnitude = gather_w(shadow_position, index);
+  r.at.normal = gather_xyz(shadow_geometric, index);
+  r.shading_normal = gather_xyz(shadow_normal, index);
+  r.albedo = gather_xyz(shadow_albedo, index);
+  r.throughput = gather_xyz(shadow_throughput, index);
+  r.wo = gather_xyz(shadow_wo, index);
+  r.material = gather_int(shadow_material, index);
+  r.depth = gather_uint(shadow_depth, index);
+  return r;
+}
 #endif
 
 // Passes in flight on a device: pass p uses pass-buffer slot p % FH_PASS_SLOTS.

@@ -37,31 +37,32 @@ FH_INLINE lfloat emission_weight(luint depth, lfloat bsdf_pdf, __global const fl
 #endif
 }
 
-__kernel void shade(RenderParams params, __global const uint* ray_queue, __global uint* next_queue,
-                    __global uint* finished_queue, volatile __global WavefrontCounters* counters, uint parity,
-                    __global const float4* triangles, __global const int* triangle_material,
-                    __global const GpuMaterial* materials, __global const float* light_pdf_area,
-                    __global const float4* normals, __global const float2* uvs, __global const float4* texels,
-                    __global const uint4* texture_info FH_PATH_PARAMS FH_SHADOW_PARAMS) {
-  volatile __local uint scratch[2 * 3];
-  const luint position = lane_positions(get_global_id(0) * FH_LANES);
-  const lmask active = position < counters->ray_length[parity];
-  luint p = (luint)(0);
-  lmask continues = lanes_mask(false), light_sample = lanes_mask(false);
-  // What a light-sample request needs, kept until its queue position is known.
-  SurfacePoint s;
-  s.position = s.normal = v3_splat(0.0f);
-  s.magnitude = (lfloat)(0.0f);
-  lvec3 beta_in = v3_splat(0.0f), g = v3_splat(0.0f), n = v3_splat(0.0f), albedo = v3_splat(0.0f),
-        wo = v3_splat(0.0f);
-  lint material_id = (lint)(0);
-  luint bounce = (luint)(0);
+// What shading decided for FH_LANES paths: which go on to another bounce, which asked for
+// a light sample (described by `request`), which are finished.
+typedef struct {
+  lmask continues, light_sample, finished;
+  ShadowRequest request;
+} ShadeOutcome;
+
+// Shades path slots p where `active`: adds what the paths gathered at their hits to their
+// radiance and, for those that go on, writes the next ray, throughput, pdf and depth.
+FH_INLINE ShadeOutcome shade_paths(RenderParams params, luint p, lmask active, __global const float4* triangles,
+                                   __global const int* triangle_material, __global const GpuMaterial* materials,
+                                   __global const float* light_pdf_area, __global const float4* normals,
+                                   __global const float2* uvs, __global const float4* texels,
+                                   __global const uint4* texture_info FH_PATH_PARAMS) {
+  ShadeOutcome o;
+  o.continues = o.light_sample = lanes_mask(false);
+  // What a light-sample request needs (zero where none is made).
+  ShadowRequest* r = &o.request;
+  r->path = p;
+  r->at.position = r->at.normal = r->shading_normal = r->albedo = r->throughput = r->wo = v3_splat(0.0f);
+  r->at.magnitude = (lfloat)(0.0f);
+  r->material = (lint)(0);
+  r->depth = (luint)(0);
   if (lanes_any(active)) {
-    // Idle lanes (past the queue's end) read the work-item's first path, which no other
-    // work-item writes, and write nothing.
-    p = gather_uint(ray_queue, select((luint)(LANE(position, 0)), position, active));
-    beta_in = gather_xyz(throughput, p);
-    bounce = gather_uint(depth, p);
+    const lvec3 beta_in = gather_xyz(throughput, p);
+    const luint bounce = gather_uint(depth, p);
     lvec3 gathered = gather_xyz(radiance, p);
     const lvec3 h = gather_xyz(hit, p);  // t, b1, b2
     const lint hit_triangle = las_int(gather_w(hit, p));
@@ -70,10 +71,10 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
 
     if (lanes_any(hits)) {
       const lint t = select((lint)(0), hit_triangle, hits);
-      s = surface_point(triangles, t, h.y, h.z);
-      material_id = gather_int(triangle_material, las_uint(t));
+      const SurfacePoint s = surface_point(triangles, t, h.y, h.z);
+      const lint material_id = gather_int(triangle_material, las_uint(t));
       const MaterialLanes m = material_lanes(materials, material_id);
-      wo = v3_neg(gather_xyz(ray_dir, p));
+      const lvec3 wo = v3_neg(gather_xyz(ray_dir, p));
       const lfloat cos_front = v3_dot(s.normal, wo);
 
       // Emission leaves the front (counter-clockwise) side only. The MIS weight measures
@@ -102,10 +103,16 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
   #if !defined(FH_METHOD_PT)
       // Two-sided shading for opaque surfaces: the normals on the viewer's side.
       const lmask front = cos_front >= 0.0f;
-      g = v3_select(front, s.normal, v3_neg(s.normal));
-      n = v3_select(front, ns, v3_neg(ns));
-      light_sample = may_bounce && params.light_count > 0 && bsdf_has_smooth_lobe(&bsdf);
-      albedo = bsdf.kd;
+      o.light_sample = may_bounce && params.light_count > 0 && bsdf_has_smooth_lobe(&bsdf);
+      r->at.position = s.position;
+      r->at.magnitude = s.magnitude;
+      r->at.normal = v3_select(front, s.normal, v3_neg(s.normal));
+      r->shading_normal = v3_select(front, ns, v3_neg(ns));
+      r->albedo = bsdf.kd;
+      r->throughput = beta_in;
+      r->wo = wo;
+      r->material = material_id;
+      r->depth = bounce;
   #endif
 
       if (lanes_any(may_bounce)) {
@@ -114,7 +121,7 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
         const lvec2 u = sample_2d(&sampler, dim + FH_DIM_BSDF_U1);
         const BsdfSample b = bsdf_sample(&bsdf, s.normal, ns, wo, sample_1d(&sampler, dim + FH_DIM_BSDF_LOBE), u.x, u.y);
         lvec3 beta = v3_mul(beta_in, b.weight);
-        continues = may_bounce && b.pdf != 0.0f;
+        lmask continues = may_bounce && b.pdf != 0.0f;
         // Russian roulette: survive with a probability from the throughput (capped, so
         // bright paths still end); dividing by it keeps the estimator unbiased.
         const lmask roulette = continues && bounce + 1 >= params.rr_depth;
@@ -130,28 +137,38 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
         scatter_xyzw(throughput, p, beta, (lfloat)(0.0f), continues);
         scatter_float(ray_pdf, p, b.pdf, continues);
         scatter_uint(depth, p, bounce + 1, continues);
+        o.continues = continues;
       }
     }
     scatter_xyzw(radiance, p, gathered, (lfloat)(0.0f), active);
   }
+  o.finished = active && !o.continues;
+  return o;
+}
+
+__kernel void shade(RenderParams params, __global const uint* ray_queue, __global uint* next_queue,
+                    __global uint* finished_queue, volatile __global WavefrontCounters* counters, uint parity,
+                    __global const float4* triangles, __global const int* triangle_material,
+                    __global const GpuMaterial* materials, __global const float* light_pdf_area,
+                    __global const float4* normals, __global const float2* uvs, __global const float4* texels,
+                    __global const uint4* texture_info FH_PATH_PARAMS FH_SHADOW_PARAMS) {
+  volatile __local uint scratch[2 * 3];
+  const luint position = lane_positions(get_global_id(0) * FH_LANES);
+  const lmask active = position < counters->ray_length[parity];
+  // Idle lanes (past the queue's end) read the work-item's first path, which no other
+  // work-item writes, and write nothing.
+  const luint p =
+      lanes_any(active) ? gather_uint(ray_queue, select((luint)(LANE(position, 0)), position, active)) : (luint)(0);
+  const ShadeOutcome o = shade_paths(params, p, active, triangles, triangle_material, materials, light_pdf_area,
+                                     normals, uvs, texels, texture_info FH_PATH_ARGS);
 
   // Continuing paths to the next ray queue, light-sample requests to shadow_connect's,
   // finished paths to accumulate's.
-  const lmask append[3] = {continues, light_sample, active && !continues};
+  const lmask append[3] = {o.continues, o.light_sample, o.finished};
   __global uint* const queues[3] = {next_queue, shadow_path, finished_queue};
   volatile __global uint* const lengths[3] = {&counters->ray_length[1 - parity], &counters->shadow_length,
                                               &counters->finished_length};
   luint positions[3];
   queue_append_each(3, append, p, queues, lengths, scratch, positions);
-  const luint request = positions[1];
-  if (lanes_any(light_sample)) {
-    scatter_xyzw(shadow_position, request, s.position, s.magnitude, light_sample);
-    scatter_xyzw(shadow_normal, request, n, (lfloat)(0.0f), light_sample);
-    scatter_xyzw(shadow_throughput, request, beta_in, (lfloat)(0.0f), light_sample);
-    scatter_xyzw(shadow_wo, request, wo, (lfloat)(0.0f), light_sample);
-    scatter_xyzw(shadow_geometric, request, g, (lfloat)(0.0f), light_sample);
-    scatter_xyzw(shadow_albedo, request, albedo, (lfloat)(0.0f), light_sample);
-    scatter_int(shadow_material, request, material_id, light_sample);
-    scatter_uint(shadow_depth, request, bounce, light_sample);
-  }
+  if (lanes_any(o.light_sample)) store_shadow_request(&o.request, positions[1], o.light_sample FH_SHADOW_ARGS);
 }

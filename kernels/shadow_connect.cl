@@ -12,24 +12,18 @@
 #include "sampler.h"
 #include "sampling.h"
 
-__kernel void shadow_connect(RenderParams params, __global const WavefrontCounters* counters,
-                             __global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
-                             __global const float4* triangles, __global const int* triangle_material,
-                             __global const GpuMaterial* materials, __global const float* light_cdf,
-                             __global const int* light_triangle, __global const float* light_pdf_area
-                                 FH_PATH_PARAMS FH_SHADOW_PARAMS) {
-  const luint position = lane_positions(get_global_id(0) * FH_LANES);
-  const lmask active = position < counters->shadow_length;
-  if (!lanes_any(active)) return;
-  const luint i = select((luint)(0), position, active);  // idle lanes read request 0
-  const luint p = gather_uint(shadow_path, i);
-  SurfacePoint s;
-  s.position = gather_xyz(shadow_position, i);
-  s.magnitude = gather_w(shadow_position, i);
-  s.normal = gather_xyz(shadow_geometric, i);  // the geometric normal on the viewer's side
-  const lvec3 n = gather_xyz(shadow_normal, i);  // the shading normal, same side
+// Connects the requests r where `active`: adds each unoccluded light sample's contribution
+// to its path's radiance.
+FH_INLINE void connect_light(RenderParams params, const ShadowRequest* r, lmask active, __global const Bvh8Node* nodes,
+                             __global const TriangleBlock8* blocks, __global const float4* triangles,
+                             __global const int* triangle_material, __global const GpuMaterial* materials,
+                             __global const float* light_cdf, __global const int* light_triangle,
+                             __global const float* light_pdf_area FH_PATH_PARAMS) {
+  const luint p = r->path;
+  const SurfacePoint s = r->at;  // its normal: the geometric normal on the viewer's side
+  const lvec3 n = r->shading_normal;  // same side
   const PixelSampler sampler = pixel_sampler(params.seed, gather_uint(sample_id, p), params.pixel_count);
-  const luint dim = gather_uint(shadow_depth, i) * FH_DIMS_PER_BOUNCE;
+  const luint dim = r->depth * FH_DIMS_PER_BOUNCE;
 
   // Connect from the point just off the surface that BSDF-sampled rays also start from:
   // both strategies then see the same geometry, and their MIS weights sum to one even
@@ -55,10 +49,10 @@ __kernel void shadow_connect(RenderParams params, __global const WavefrontCounte
   lmask connects = active && dist2 > 0.0f && cos_surface > 0.0f && v3_dot(s.normal, wi) > 0.0f && cos_light > 0.0f;
   if (!lanes_any(connects)) return;
 
-  const MaterialLanes m = material_lanes(materials, gather_int(shadow_material, i));
+  const MaterialLanes m = material_lanes(materials, r->material);
   Bsdf bsdf = material_bsdf(&m);
-  bsdf.kd = gather_xyz(shadow_albedo, i);  // textured or not, as shade found it
-  const lvec3 wo = gather_xyz(shadow_wo, i);
+  bsdf.kd = r->albedo;  // textured or not, as shade found it
+  const lvec3 wo = r->wo;
   const lvec3 f = bsdf_eval(&bsdf, n, wo, wi);
   const lfloat pdf_light = light_pdf(&light_tri, dist2, cos_light);
 #if defined(FH_METHOD_MIS)
@@ -67,7 +61,7 @@ __kernel void shadow_connect(RenderParams params, __global const WavefrontCounte
   const lfloat weight = (lfloat)(1.0f);
 #endif
   const lvec3 ke = material_lanes(materials, gather_int(triangle_material, las_uint(lt))).ke;
-  const lvec3 contribution = v3_scale(v3_mul(v3_mul(gather_xyz(shadow_throughput, i), f), ke), cos_surface * weight / pdf_light);
+  const lvec3 contribution = v3_scale(v3_mul(v3_mul(r->throughput, f), ke), cos_surface * weight / pdf_light);
   connects = connects && v3_any_positive(contribution);
 
   // V(x, y): the segment from just off the surface to just short of the light point.
@@ -81,4 +75,18 @@ __kernel void shadow_connect(RenderParams params, __global const WavefrontCounte
       continue;
     radiance[LANE(p, k)] += (float4)(v3_lane(contribution, k), 0.0f);
   }
+}
+
+__kernel void shadow_connect(RenderParams params, __global const WavefrontCounters* counters,
+                             __global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
+                             __global const float4* triangles, __global const int* triangle_material,
+                             __global const GpuMaterial* materials, __global const float* light_cdf,
+                             __global const int* light_triangle, __global const float* light_pdf_area
+                                 FH_PATH_PARAMS FH_SHADOW_PARAMS) {
+  const luint position = lane_positions(get_global_id(0) * FH_LANES);
+  const lmask active = position < counters->shadow_length;
+  if (!lanes_any(active)) return;
+  const ShadowRequest r = load_shadow_request(select((luint)(0), position, active) FH_SHADOW_ARGS);  // idle lanes read request 0
+  connect_light(params, &r, active, nodes, blocks, triangles, triangle_material, materials, light_cdf, light_triangle,
+                light_pdf_area FH_PATH_ARGS);
 }

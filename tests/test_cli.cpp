@@ -39,7 +39,7 @@ TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
       {"--wavefront 0", "--wavefront must be at least 64"},
       {"--spp 1 --spp 2", "fredholm: error: --spp"},
       // Issue 13: the strategy and roulette flags.
-      {"--strategy vector", "--strategy 'vector': unknown strategy (use auto, scalar or simd8)"},
+      {"--strategy vector", "--strategy 'vector': unknown strategy (use auto, scalar, simd8, megakernel or megakernel8)"},
       {"--rr-depth 0", "--rr-depth must be at least 1"},
   };
   for (const auto& [flags, message] : cases) {

@@ -269,9 +269,10 @@ TEST(PathTracer, SpecializedAndAllFeatureKernelsAgree) {
 }
 
 // The strategies run the same code with the same arithmetic, lane by lane: for a seed, one
-// path per work-item and eight in vector lanes render the same bits, on a scene with every
-// material feature (texture, glossy, mirror, glass, shading normals) and for every method.
-TEST(PathTracer, ScalarAndSimd8StrategiesRenderTheSameBits) {
+// path per work-item, eight in vector lanes and the megakernel render the same bits, on a
+// scene with every material feature (texture, glossy, mirror, glass, shading normals) and
+// for every method.
+TEST(PathTracer, EveryStrategyRendersTheSameBits) {
   const Scene scene = loadScene(test::writeFeatureScene(test::tempDir("strategies")));
   static DeviceContext dc(selectDevices(listDevices(), "").front());
   const Bvh bvh = buildBvh(scene);
@@ -285,12 +286,16 @@ TEST(PathTracer, ScalarAndSimd8StrategiesRenderTheSameBits) {
     s.method = method;
     s.strategy = Strategy::Scalar;
     const RenderResult scalar = fh::render(dc, scene, bvh, camera, s);
-    s.strategy = Strategy::Simd8;
-    const RenderResult simd8 = fh::render(dc, scene, bvh, camera, s);
-    EXPECT_EQ(scalar.stats.bounceRays, simd8.stats.bounceRays) << methodName(method);
-    EXPECT_EQ(scalar.stats.shadowRays, simd8.stats.shadowRays) << methodName(method);
     EXPECT_GT(scalar.stats.bounceRays, 0u);
-    EXPECT_TRUE(scalar.film.sum == simd8.film.sum) << methodName(method) << ": the images differ";
+    for (Strategy other : {Strategy::Simd8, Strategy::Megakernel, Strategy::Megakernel8}) {
+      s.strategy = other;
+      const RenderResult r = fh::render(dc, scene, bvh, camera, s);
+      const std::string what = std::string(methodName(method)) + ", " + strategyName(other);
+      EXPECT_EQ(scalar.stats.bounceRays, r.stats.bounceRays) << what;
+      EXPECT_EQ(scalar.stats.shadowRays, r.stats.shadowRays) << what;
+      EXPECT_EQ(scalar.stats.nonfinite, r.stats.nonfinite) << what;
+      EXPECT_TRUE(scalar.film.sum == r.film.sum) << what << ": the images differ from scalar's";
+    }
   }
 }
 

@@ -20,7 +20,9 @@ Strategy parseStrategy(const std::string& name) {
   if (name == "auto") return Strategy::Auto;
   if (name == "scalar") return Strategy::Scalar;
   if (name == "simd8") return Strategy::Simd8;
-  throw Error("--strategy '" + name + "': unknown strategy (use auto, scalar or simd8)");
+  if (name == "megakernel") return Strategy::Megakernel;
+  if (name == "megakernel8") return Strategy::Megakernel8;
+  throw Error("--strategy '" + name + "': unknown strategy (use auto, scalar, simd8, megakernel or megakernel8)");
 }
 
 PixelFilter parseFilter(const std::string& name) {

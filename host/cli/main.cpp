@@ -50,7 +50,8 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
   rendering->add_option("--stats", o.statsFile, "Write render statistics as JSON");
   rendering->add_option("--strategy", o.strategy,
                         "How devices run the stages: auto (by device type), scalar (one path per work-item, for "
-                        "GPUs) or simd8 (eight paths per work-item in vector lanes, for CPUs)")
+                        "GPUs), simd8 (eight paths per work-item in vector lanes, for CPUs) or megakernel (every "
+                        "stage in one kernel: a baseline for measurements)")
       ->capture_default_str();
   rendering->add_flag("--all-features", o.allFeatures,
                       "Compile every material feature, not only the scene's (to measure specialization)");

@@ -8,7 +8,14 @@ namespace fh {
 const char* methodName(Method m) { return m == Method::PT ? "pt" : m == Method::NEE ? "nee" : "mis"; }
 
 const char* strategyName(Strategy s) {
-  return s == Strategy::Auto ? "auto" : s == Strategy::Scalar ? "scalar" : "simd8";
+  switch (s) {
+    case Strategy::Auto: return "auto";
+    case Strategy::Scalar: return "scalar";
+    case Strategy::Simd8: return "simd8";
+    case Strategy::Megakernel: return "megakernel";
+    case Strategy::Megakernel8: return "megakernel8";
+  }
+  return "?";
 }
 
 const char* filterName(PixelFilter f) {

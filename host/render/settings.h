@@ -15,10 +15,13 @@ const char* methodName(Method m);
 enum class PixelFilter { Box, Gaussian, BlackmanHarris };
 const char* filterName(PixelFilter f);
 
-// How a device runs the stages: one path per work-item (GPUs: wide global queues) or eight
-// paths per work-item in vector lanes (CPUs: PoCL does not vectorize divergent shading
-// across work-items, kernels/lanes.h). Both compute the same estimator.
-enum class Strategy { Auto, Scalar, Simd8 };
+// How a device runs the stages: as a wavefront of kernels over queues with one path per
+// work-item (Scalar: GPUs) or eight in vector lanes (Simd8; PoCL does not vectorize
+// divergent shading across work-items, kernels/lanes.h), or all in one kernel that loops
+// over the stages for one path per work-item (Megakernel) or eight (Megakernel8: CPUs,
+// whose caches keep a path's state close while a wavefront streams it through memory).
+// All compute the same estimator.
+enum class Strategy { Auto, Scalar, Simd8, Megakernel, Megakernel8 };
 const char* strategyName(Strategy s);
 
 struct RenderSettings {

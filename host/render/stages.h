@@ -29,6 +29,9 @@ constexpr std::array<StageInfo, 7> kStages = {{
 
 constexpr const StageInfo& stageInfo(Stage s) { return kStages[size_t(s)]; }
 
+// The megakernel strategy runs the books around one kernel that calls every stage between.
+constexpr StageInfo kMegakernel = {"megakernel", "megakernel.cl"};
+
 // The kernel files of every stage, each once, in stage order.
 inline std::vector<std::string> stageFiles() {
   std::vector<std::string> files;

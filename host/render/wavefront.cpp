@@ -61,11 +61,13 @@ gpu::RenderParams renderParams(const RenderSettings& s, const Camera& camera, un
 ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsigned passSlots,
                               const std::string& traversalOptions, Strategy strategy) {
   const char* methodFlag = method == Method::PT ? "PT" : method == Method::NEE ? "NEE" : "MIS";
+  const bool mega = isMegakernel(strategy);
   return {std::string("path tracer (") + methodName(method) + features.buildOptions() + ", " + strategyName(strategy) +
               ")",
-          stageFiles(),
+          mega ? std::vector<std::string>{stageInfo(Stage::PlanIteration).file, kMegakernel.file} : stageFiles(),
           traversalOptions + features.buildOptions() + " -DFH_PASS_SLOTS=" + std::to_string(passSlots) +
-              " -DFH_METHOD_" + methodFlag + " -DFH_LANES=" + std::to_string(lanesOf(strategy))};
+              " -DFH_METHOD_" + methodFlag + " -DFH_LANES=" + std::to_string(lanesOf(strategy)) +
+              (mega ? " -DFH_MEGAKERNEL" : "")};
 }
 
 Strategy strategyFor(const DeviceInfo& device, Strategy asked) {
@@ -73,7 +75,9 @@ Strategy strategyFor(const DeviceInfo& device, Strategy asked) {
   return device.type == "cpu" ? Strategy::Simd8 : Strategy::Scalar;
 }
 
-unsigned lanesOf(Strategy s) { return s == Strategy::Simd8 ? 8 : 1; }
+unsigned lanesOf(Strategy s) { return s == Strategy::Simd8 || s == Strategy::Megakernel8 ? 8 : 1; }
+
+bool isMegakernel(Strategy s) { return s == Strategy::Megakernel || s == Strategy::Megakernel8; }
 
 size_t defaultWavefront(const DeviceInfo& device, size_t pixels) {
   // GPU: the best of the H200 sweep in bench/RESULTS.md (issue 12); larger wavefronts ran emptier.
@@ -106,8 +110,11 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
   const cl::Program program = buildProgram(
       dc.context, dc.info.device, pathTracerProgram(scene_.features, s.method, passSlots_, scene_.bvh.traversalOptions(),
                                                          strategy_));
+  // The megakernel's program holds every stage's kernel too (megakernel.cl includes them).
   for (auto& kernels : kernels_)
     for (size_t i = 0; i < kStages.size(); ++i) kernels[i] = createKernel(program, kStages[i].kernel);
+  if (isMegakernel(strategy_))
+    for (auto& k : megakernels_) k = createKernel(program, kMegakernel.kernel);
   allocateBuffers(filterTable);
   bindArguments(0);
   bindArguments(1);
@@ -160,11 +167,24 @@ void WavefrontPipeline::bindArguments(unsigned parity) {
   args(Stage::Accumulate) << queues_.finished << queues_.counters << queues_.freeSlots << pixels_ << passBuffers_
                           << paths_;
   args(Stage::FinishIteration) << queues_.counters << parity;
+  if (isMegakernel(strategy_))
+    ArgumentList(megakernels_[parity])
+        << params_ << queues_.counters << parity << queues_.freeSlots << filterTable_ << passTableBuffer_
+        << sc.bvh.nodes() << sc.bvh.blocks() << sc.bvh.triangles() << sc.triangleMaterial << sc.materials
+        << sc.lightCdf << sc.lightTriangle << sc.lightPdfArea << sc.normals << sc.uvs << sc.texels << sc.textureInfo
+        << passBuffers_ << paths_;
 }
 
 // Each stage is launched over the whole wavefront and reads its queue's length on the
 // device, so nothing here waits for the device.
 void WavefrontPipeline::enqueueIteration() {
+  if (isMegakernel(strategy_)) {
+    planIteration();
+    megakernel();
+    finishIteration();
+    parity_ = 1 - parity_;
+    return;
+  }
   planIteration();
   generate();
   intersect();
@@ -175,10 +195,16 @@ void WavefrontPipeline::enqueueIteration() {
   parity_ = 1 - parity_;
 }
 
+void WavefrontPipeline::megakernel() {
+  cl::Event event;
+  launch(dc_, megakernels_[parity_], laneItems(), kMegakernel.kernel, &event);
+  events_.emplace_back(kMegakernel.kernel, event);
+}
+
 void WavefrontPipeline::run(Stage stage, size_t items) {
   cl::Event event;
   launch(dc_, kernels_[parity_][size_t(stage)], items, stageInfo(stage).kernel, &event);
-  events_.emplace_back(stage, event);
+  events_.emplace_back(stageInfo(stage).kernel, event);
 }
 
 void WavefrontPipeline::writeCounter(size_t offset, const uint32_t& value) {
@@ -199,11 +225,11 @@ void WavefrontPipeline::startGrantedPasses(uint64_t granted) {
 
 const gpu::WavefrontCounters& WavefrontPipeline::readCounters() {
   FH_CL(dc_.queue.enqueueReadBuffer(queues_.counters, CL_TRUE, 0, sizeof counters_, &counters_));
-  for (const auto& [stage, event] : events_) {
+  for (const auto& [kernel, event] : events_) {
     cl_ulong start = 0, end = 0;
     FH_CL(event.getProfilingInfo(CL_PROFILING_COMMAND_START, &start));
     FH_CL(event.getProfilingInfo(CL_PROFILING_COMMAND_END, &end));
-    stageSeconds_[stageInfo(stage).kernel] += double(end - start) * 1e-9;
+    stageSeconds_[kernel] += double(end - start) * 1e-9;
   }
   events_.clear();
   return counters_;

@@ -42,7 +42,8 @@ struct SlotQueues {
 };
 
 // The path tracer's program for a scene's features, a method, the passes in flight and a
-// strategy (Scalar or Simd8: the paths each work-item carries, FH_LANES).
+// strategy (Scalar or Simd8: the paths each work-item carries, FH_LANES; Megakernel: the
+// books and the megakernel).
 ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsigned passSlots,
                               const std::string& traversalOptions, Strategy strategy);
 
@@ -51,6 +52,8 @@ ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsi
 Strategy strategyFor(const DeviceInfo& device, Strategy asked);
 // Paths per work-item in the stages written with lanes (all but intersect and the books).
 unsigned lanesOf(Strategy s);
+// Whether the strategy runs the stages in one kernel (kernels/megakernel.cl).
+bool isMegakernel(Strategy s);
 
 // The default number of paths in flight: 512k on a GPU, fewer on a CPU, where the
 // path state should stay near the caches; never more than two passes of pixels.
@@ -92,6 +95,7 @@ class WavefrontPipeline {
   void planIteration() { run(Stage::PlanIteration, 1); }
   // Stages with lanes take lanesOf(strategy_) paths per work-item; intersect one ray each.
   void generate() { run(Stage::Generate, laneItems()); }
+  void megakernel();
   void intersect() { run(Stage::Intersect, wavefront_); }
   void shade() { run(Stage::Shade, laneItems()); }
   void shadowConnect() { run(Stage::ShadowConnect, laneItems()); }
@@ -121,7 +125,8 @@ class WavefrontPipeline {
   gpu::WavefrontCounters counters_{};
   // Every stage's kernel twice, bound once for each parity: an iteration sets nothing.
   std::array<std::array<cl::Kernel, kStages.size()>, 2> kernels_;
-  std::vector<std::pair<Stage, cl::Event>> events_;
+  std::array<cl::Kernel, 2> megakernels_;  // the Megakernel strategy's, for each parity
+  std::vector<std::pair<const char*, cl::Event>> events_;  // by kernel name, to be timed
   std::map<std::string, double> stageSeconds_;
 };
 

@@ -1,0 +1,87 @@
+// The megakernel strategies: each work-item runs every stage for its FH_LANES path slots
+// in one kernel, in a loop (no queues; a light-sample request goes straight to
+// connect_light), and where a lane's path ends, starts the lane's next sample in the same
+// slot (path regeneration), so lanes stay busy although paths differ in length. It calls
+// the stages' own functions, so it computes the same estimator and the same image bits for
+// a seed. Every path it starts ends in the same launch: plan_iteration (built with
+// FH_MEGAKERNEL) carries no rays over, and the free list is left as it was.
+#include "accumulate.cl"
+#include "generate.cl"
+#include "intersect.cl"
+#include "shade.cl"
+#include "shadow_connect.cl"
+
+// Lanes set in m (FH_LANES paths per work-item).
+FH_INLINE uint lanes_count(lmask m) {
+  uint n = 0;
+  FH_FOR_LANES(l) n += LANE(m, l) ? 1u : 0u;
+  return n;
+}
+
+__kernel void megakernel(RenderParams params, volatile __global WavefrontCounters* counters, uint parity,
+                         __global const uint* free_list, __global const float* filter_table,
+                         __global const uint* pass_table, __global const Bvh8Node* nodes,
+                         __global const TriangleBlock8* blocks, __global const float4* triangles,
+                         __global const int* triangle_material, __global const GpuMaterial* materials,
+                         __global const float* light_cdf, __global const int* light_triangle,
+                         __global const float* light_pdf_area, __global const float4* normals,
+                         __global const float2* uvs, __global const float4* texels,
+                         __global const uint4* texture_info, __global float4* pass_buffer FH_PATH_PARAMS) {
+  // The work-group's books, added to the device's once at the end (see queue_append_each):
+  // samples finished per pass slot, then bounce rays, shadow rays and non-finite samples.
+  volatile __local uint finished_in_slot[FH_PASS_SLOTS], totals[3];
+  const uint lid = get_local_id(0);
+  if (lid < FH_PASS_SLOTS) finished_in_slot[lid] = 0;
+  if (lid < 3) totals[lid] = 0;
+  barrier(CLK_LOCAL_MEM_FENCE);
+
+  // Lane g owns free slot g (all are free between launches) and takes samples g, g + slots,
+  // g + 2 slots, ... of the new_count planned.
+  const uint slots = counters->new_free_top, count = counters->new_count;
+  const luint g = lane_positions(get_global_id(0) * FH_LANES);
+  const lmask owns_slot = g < slots && g < count;
+  if (lanes_any(owns_slot)) {
+    const luint p = gather_uint(free_list, slots - 1 - select((luint)(0), g, owns_slot));
+    luint next = g;  // the lane's next sample
+    lmask alive = lanes_mask(false);
+    uint bounce_rays = 0, shadow_rays = 0, nonfinite = 0;
+    for (;;) {
+      const lmask starts = owns_slot && !alive && next < count;
+      if (lanes_any(starts)) {
+        start_sample(params, counters->new_first + next, p, starts, filter_table, pass_table FH_PATH_ARGS);
+        next = select(next, next + slots, starts);
+        alive = alive || starts;
+      }
+      if (!lanes_any(alive)) break;
+      FH_FOR_LANES(l) {
+        if (LANE(alive, l)) intersect_slot(nodes, blocks, LANE(p, l), ray_org, ray_dir, hit);
+      }
+      const ShadeOutcome o = shade_paths(params, p, alive, triangles, triangle_material, materials, light_pdf_area,
+                                         normals, uvs, texels, texture_info FH_PATH_ARGS);
+      if (lanes_any(o.light_sample))  // never for pt, nor without lights
+        connect_light(params, &o.request, o.light_sample, nodes, blocks, triangles, triangle_material, materials,
+                      light_cdf, light_triangle, light_pdf_area FH_PATH_ARGS);
+      shadow_rays += lanes_count(o.light_sample);
+      bounce_rays += lanes_count(o.continues);
+      if (lanes_any(o.finished)) {
+        luint slot;
+        const lmask finite = record_samples(p, o.finished, params.pixel_count, pass_buffer, &slot FH_PATH_ARGS);
+        FH_FOR_LANES(l) {
+          if (LANE(o.finished, l)) atomic_inc(&finished_in_slot[LANE(slot, l)]);
+        }
+        nonfinite += lanes_count(o.finished && !finite);
+      }
+      alive = o.continues;
+    }
+    if (bounce_rays) atomic_add(&totals[0], bounce_rays);
+    if (shadow_rays) atomic_add(&totals[1], shadow_rays);
+    if (nonfinite) atomic_add(&totals[2], nonfinite);
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (lid < FH_PASS_SLOTS && finished_in_slot[lid]) atomic_add(&counters->pass_done[lid], finished_in_slot[lid]);
+  if (lid == 0) {
+    if (totals[0]) atomic_add(&counters->ray_length[1 - parity], totals[0]);
+    if (totals[1]) atomic_add(&counters->shadow_length, totals[1]);
+    if (totals[2]) atomic_add(&counters->nonfinite, totals[2]);
+  }
+}
