@@ -100,6 +100,13 @@ FH_INLINE lfloat v3_max_component(lvec3 a) { return fmax(fmax(a.x, a.y), a.z); }
 // A mask of every lane (true) or none.
 FH_INLINE lmask lanes_mask(bool all) { return (lint)(all ? 1 : 0) != 0; }
 // Lanes where any component is positive.
+// How many lanes m sets.
+FH_INLINE uint lanes_count(lmask m) {
+  uint n = 0;
+  FH_FOR_LANES(l) n += LANE(m, l) ? 1u : 0u;
+  return n;
+}
+
 FH_INLINE lmask v3_any_positive(lvec3 a) { return a.x > 0.0f || a.y > 0.0f || a.z > 0.0f; }
 // Lanes of `if_true` where m is set, of `if_false` elsewhere.
 FH_INLINE lvec3 v3_select(lmask m, lvec3 if_true, lvec3 if_false) {

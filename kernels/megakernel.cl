@@ -11,13 +11,6 @@
 #include "shade.cl"
 #include "shadow_connect.cl"
 
-// Lanes set in m (FH_LANES paths per work-item).
-FH_INLINE uint lanes_count(lmask m) {
-  uint n = 0;
-  FH_FOR_LANES(l) n += LANE(m, l) ? 1u : 0u;
-  return n;
-}
-
 __kernel void megakernel(RenderParams params, volatile __global WavefrontCounters* counters, uint parity,
                          __global const uint* free_list, __global const float* filter_table,
                          __global const uint* pass_table, __global const Bvh8Node* nodes,

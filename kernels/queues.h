@@ -21,10 +21,7 @@ FH_INLINE void queue_append_each(int n, const lmask* append, luint slot, __globa
                                  volatile __global uint* const* lengths, volatile __local uint* scratch,
                                  luint* positions) {
   uint count[FH_MAX_QUEUES_AT_ONCE], first[FH_MAX_QUEUES_AT_ONCE];
-  for (int q = 0; q < n; ++q) {
-    count[q] = 0;
-    FH_FOR_LANES(l) count[q] += LANE(append[q], l) ? 1u : 0u;
-  }
+  for (int q = 0; q < n; ++q) count[q] = lanes_count(append[q]);
   barrier(CLK_LOCAL_MEM_FENCE);
   if (get_local_id(0) == 0)
     for (int q = 0; q < n; ++q) scratch[q] = 0;

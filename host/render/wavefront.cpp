@@ -178,19 +178,16 @@ void WavefrontPipeline::bindArguments(unsigned parity) {
 // Each stage is launched over the whole wavefront and reads its queue's length on the
 // device, so nothing here waits for the device.
 void WavefrontPipeline::enqueueIteration() {
-  if (isMegakernel(strategy_)) {
-    planIteration();
-    megakernel();
-    finishIteration();
-    parity_ = 1 - parity_;
-    return;
-  }
   planIteration();
-  generate();
-  intersect();
-  shade();
-  if (method_ != Method::PT && scene_.lightCount > 0) shadowConnect();
-  accumulate();
+  if (isMegakernel(strategy_)) {
+    megakernel();
+  } else {
+    generate();
+    intersect();
+    shade();
+    if (method_ != Method::PT && scene_.lightCount > 0) shadowConnect();
+    accumulate();
+  }
   finishIteration();
   parity_ = 1 - parity_;
 }

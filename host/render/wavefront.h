@@ -42,8 +42,8 @@ struct SlotQueues {
 };
 
 // The path tracer's program for a scene's features, a method, the passes in flight and a
-// strategy (Scalar or Simd8: the paths each work-item carries, FH_LANES; Megakernel: the
-// books and the megakernel).
+// strategy (the paths each work-item carries, FH_LANES; for the megakernels, the books and
+// megakernel.cl instead of the stage files).
 ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsigned passSlots,
                               const std::string& traversalOptions, Strategy strategy);
 
