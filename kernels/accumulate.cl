@@ -21,6 +21,7 @@ FH_INLINE lmask record_samples(luint p, lmask active, uint pixel_count, __global
   return finite;
 }
 
+#if !defined(FH_MEGAKERNEL)  // the megakernel calls the stage function itself
 __kernel void accumulate(__global const uint* finished_queue, volatile __global WavefrontCounters* counters,
                          __global uint* free_list, uint pixel_count, __global float4* pass_buffer FH_PATH_PARAMS) {
   volatile __local uint finished_in_slot[FH_PASS_SLOTS];
@@ -46,3 +47,4 @@ __kernel void accumulate(__global const uint* finished_queue, volatile __global 
   barrier(CLK_LOCAL_MEM_FENCE);
   if (lid < FH_PASS_SLOTS && finished_in_slot[lid]) atomic_add(&counters->pass_done[lid], finished_in_slot[lid]);
 }
+#endif

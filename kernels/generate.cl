@@ -31,6 +31,7 @@ FH_INLINE void start_sample(RenderParams params, luint j, luint slot, lmask acti
   scatter_uint(depth, slot, (luint)(0), active);
 }
 
+#if !defined(FH_MEGAKERNEL)  // the megakernel calls the stage function itself
 // Starts the planned samples in the slots on top of the free list and appends them to
 // the ray queue.
 __kernel void generate(RenderParams params, __global const WavefrontCounters* counters,
@@ -44,3 +45,4 @@ __kernel void generate(RenderParams params, __global const WavefrontCounters* co
   start_sample(params, counters->new_first + i, slot, active, filter_table, pass_table FH_PATH_ARGS);
   scatter_uint(ray_queue, counters->new_queue_base + i, slot, active);
 }
+#endif

@@ -2,6 +2,7 @@
 // (origin.xyz + tmin, direction.xyz + tmax), and the path tracer's intersect stage.
 #include "intersect.h"
 
+#if !defined(FH_MEGAKERNEL)  // kernels the megakernel's program does not need
 // hits[i] = (t, b1, b2, triangle index in BVH order as bits; -1 on a miss). Per-triangle
 // data on the device is stored in that order.
 __kernel void intersect_closest(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
@@ -23,6 +24,7 @@ __kernel void intersect_any(__global const Bvh8Node* nodes, __global const Trian
   const float4 o = ray_org[i], d = ray_dir[i];
   occluded[i] = trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w, true).triangle >= 0;
 }
+#endif
 
 // Closest hit for the ray of path slot p: reads ray_org/ray_dir, writes hit.
 FH_INLINE void intersect_slot(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, uint p,
@@ -32,6 +34,7 @@ FH_INLINE void intersect_slot(__global const Bvh8Node* nodes, __global const Tri
   hit[p] = (float4)(h.triangle < 0 ? INFINITY : h.t, h.b1, h.b2, as_float(h.triangle));
 }
 
+#if !defined(FH_MEGAKERNEL)  // the megakernel calls the stage function itself
 // The intersect stage: closest hit for the paths in the current ray queue (parity picks
 // its length).
 __kernel void intersect(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
@@ -41,3 +44,4 @@ __kernel void intersect(__global const Bvh8Node* nodes, __global const TriangleB
   if (i >= counters->ray_length[parity]) return;
   intersect_slot(nodes, blocks, ray_queue[i], ray_org, ray_dir, hit);
 }
+#endif

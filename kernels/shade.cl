@@ -146,6 +146,7 @@ FH_INLINE ShadeOutcome shade_paths(RenderParams params, luint p, lmask active, _
   return o;
 }
 
+#if !defined(FH_MEGAKERNEL)  // the megakernel calls the stage function itself
 __kernel void shade(RenderParams params, __global const uint* ray_queue, __global uint* next_queue,
                     __global uint* finished_queue, volatile __global WavefrontCounters* counters, uint parity,
                     __global const float4* triangles, __global const int* triangle_material,
@@ -172,3 +173,4 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
   queue_append_each(3, append, p, queues, lengths, scratch, positions);
   if (lanes_any(o.light_sample)) store_shadow_request(&o.request, positions[1], o.light_sample FH_SHADOW_ARGS);
 }
+#endif

@@ -77,6 +77,7 @@ FH_INLINE void connect_light(RenderParams params, const ShadowRequest* r, lmask 
   }
 }
 
+#if !defined(FH_MEGAKERNEL)  // the megakernel calls the stage function itself
 __kernel void shadow_connect(RenderParams params, __global const WavefrontCounters* counters,
                              __global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
                              __global const float4* triangles, __global const int* triangle_material,
@@ -90,3 +91,4 @@ __kernel void shadow_connect(RenderParams params, __global const WavefrontCounte
   connect_light(params, &r, active, nodes, blocks, triangles, triangle_material, materials, light_cdf, light_triangle,
                 light_pdf_area FH_PATH_ARGS);
 }
+#endif

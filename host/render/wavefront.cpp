@@ -79,6 +79,11 @@ unsigned lanesOf(Strategy s) { return s == Strategy::Simd8 || s == Strategy::Meg
 
 bool isMegakernel(Strategy s) { return s == Strategy::Megakernel || s == Strategy::Megakernel8; }
 
+// The books (plan, finish) run under every strategy; the megakernel calls the other stages.
+bool WavefrontPipeline::launches(Stage s) const {
+  return !isMegakernel(strategy_) || s == Stage::PlanIteration || s == Stage::FinishIteration;
+}
+
 size_t defaultWavefront(const DeviceInfo& device, size_t pixels) {
   // GPU: the best of the H200 sweep in bench/RESULTS.md (issue 12); larger wavefronts ran emptier.
   const size_t preferred = device.type == "gpu" ? (size_t(1) << 19) : (size_t(1) << 16);
@@ -110,9 +115,11 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
   const cl::Program program = buildProgram(
       dc.context, dc.info.device, pathTracerProgram(scene_.features, s.method, passSlots_, scene_.bvh.traversalOptions(),
                                                          strategy_));
-  // The megakernel's program holds every stage's kernel too (megakernel.cl includes them).
+  // The megakernel's program holds only the books' kernels besides its own: its stages are
+  // functions it calls (a kernel per stage would double PoCL's compile time for nothing).
   for (auto& kernels : kernels_)
-    for (size_t i = 0; i < kStages.size(); ++i) kernels[i] = createKernel(program, kStages[i].kernel);
+    for (size_t i = 0; i < kStages.size(); ++i)
+      if (launches(Stage(i))) kernels[i] = createKernel(program, kStages[i].kernel);
   if (isMegakernel(strategy_))
     for (auto& k : megakernels_) k = createKernel(program, kMegakernel.kernel);
   allocateBuffers(filterTable);
@@ -154,6 +161,15 @@ void WavefrontPipeline::bindArguments(unsigned parity) {
   const DeviceScene& sc = scene_;
 
   args(Stage::PlanIteration) << queues_.counters << parity;
+  args(Stage::FinishIteration) << queues_.counters << parity;
+  if (isMegakernel(strategy_)) {
+    ArgumentList(megakernels_[parity])
+        << params_ << queues_.counters << parity << queues_.freeSlots << filterTable_ << passTableBuffer_
+        << sc.bvh.nodes() << sc.bvh.blocks() << sc.bvh.triangles() << sc.triangleMaterial << sc.materials
+        << sc.lightCdf << sc.lightTriangle << sc.lightPdfArea << sc.normals << sc.uvs << sc.texels << sc.textureInfo
+        << passBuffers_ << paths_;
+    return;
+  }
   args(Stage::Generate) << params_ << queues_.counters << queues_.freeSlots << rays << filterTable_
                         << passTableBuffer_ << paths_;
   args(Stage::Intersect) << sc.bvh.nodes() << sc.bvh.blocks() << rays << queues_.counters << parity
@@ -166,13 +182,6 @@ void WavefrontPipeline::bindArguments(unsigned parity) {
                              << sc.lightTriangle << sc.lightPdfArea << paths_ << shadowRequests_;
   args(Stage::Accumulate) << queues_.finished << queues_.counters << queues_.freeSlots << pixels_ << passBuffers_
                           << paths_;
-  args(Stage::FinishIteration) << queues_.counters << parity;
-  if (isMegakernel(strategy_))
-    ArgumentList(megakernels_[parity])
-        << params_ << queues_.counters << parity << queues_.freeSlots << filterTable_ << passTableBuffer_
-        << sc.bvh.nodes() << sc.bvh.blocks() << sc.bvh.triangles() << sc.triangleMaterial << sc.materials
-        << sc.lightCdf << sc.lightTriangle << sc.lightPdfArea << sc.normals << sc.uvs << sc.texels << sc.textureInfo
-        << passBuffers_ << paths_;
 }
 
 // Each stage is launched over the whole wavefront and reads its queue's length on the

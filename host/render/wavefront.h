@@ -106,6 +106,7 @@ class WavefrontPipeline {
 
   void allocateBuffers(const std::vector<float>& filterTable);
   void bindArguments(unsigned parity);
+  bool launches(Stage s) const;  // whether this strategy launches the stage's own kernel
   void writeCounter(size_t offset, const uint32_t& value);
 
   DeviceContext& dc_;
