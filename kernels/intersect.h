@@ -16,6 +16,17 @@
 #define FH_TRAVERSAL_STACK 64
 #endif
 
+// Bit i set where lane i of `lanes` is set (lanes are 0 or -1).
+FH_INLINE uint lane_bits(int8 lanes) {
+  const int8 bits = lanes & (int8)(1, 2, 4, 8, 16, 32, 64, 128);
+  const int4 a = bits.lo | bits.hi;
+  const int2 b = a.lo | a.hi;
+  return (uint)(b.x | b.y);
+}
+
+// The index of the lowest set bit of m (m != 0). clz is OpenCL 1.2; ctz is not.
+FH_INLINE int lowest_bit(uint m) { return 31 - (int)clz(m & (0u - m)); }
+
 // Per-ray constants of the watertight test: the axis the ray is most aligned with
 // (kz), the shear that maps the ray onto +z, and the origin in that axis order.
 typedef struct {
@@ -63,9 +74,9 @@ FH_INLINE RayPrecomp precompute_ray(float3 org, float3 dir) {
 
 // The watertight test on the eight triangles of a leaf at once. Returns the lane of the
 // closest hit in [t_min, *t_max) (updating *t_max and the barycentrics b1, b2 of v1 and
-// v2), or -1.
+// v2), or -1. An any-hit query takes the lowest lane hit and updates nothing.
 FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8* block, float t_min, float* t_max,
-                           float* b1, float* b2) {
+                              float* b1, float* b2, bool any_hit) {
   __global const float* v0 = block->v[0][0];
   __global const float* v1 = block->v[1][0];
   __global const float* v2 = block->v[2][0];
@@ -92,13 +103,14 @@ FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8
   const float8 quotient = t_scaled / det;
   const int8 valid = maybe & (quotient >= (float8)(t_min)) & (quotient < (float8)(*t_max));
   if (!any(valid)) return -1;
+  if (any_hit) return lowest_bit(lane_bits(valid));
   const float8 t = select((float8)(INFINITY), quotient, valid);
-  float lanes[8];
-  vstore8(t, 0, lanes);
-  int best = 0;
-  for (int i = 1; i < 8; ++i)
-    if (lanes[i] < lanes[best]) best = i;
-  *t_max = lanes[best];
+  // The nearest lane, the lowest of equals: a min over the lanes, then the first lane at it.
+  const float4 m4 = fmin(t.lo, t.hi);
+  const float2 m2 = fmin(m4.lo, m4.hi);
+  const float nearest = fmin(m2.x, m2.y);
+  const int best = lowest_bit(lane_bits(t == (float8)(nearest)));
+  *t_max = nearest;
   float vs[8], ws[8], ds[8];
   vstore8(v, 0, vs);
   vstore8(w, 0, ws);
@@ -135,16 +147,33 @@ typedef struct {
 } TraceHit;
 
 // Visits the children the ray hits nearest first: returns the nearest (0 if none) and
-// pushes the others, farthest first, with their distances. Any-hit queries skip the
-// sort: any occluder ends them, near or far.
+// pushes the others, farthest first, with their distances; among equal distances the
+// higher lane counts as nearer. Any-hit queries skip the sort (any occluder ends them, near
+// or far) and visit the highest lane first. One or two children hit, the common cases, take
+// no loop.
 FH_INLINE int order_children(float8 t_near, __global const Bvh8Node* node, int* stack_node, float* stack_t, int* sp,
                           bool sorted) {
+  uint hits = lane_bits(t_near != (float8)(INFINITY));
+  if (hits == 0) return 0;
   float t[8];
   vstore8(t_near, 0, t);
+  const int first = lowest_bit(hits);
+  hits &= hits - 1;
+  if (hits == 0) return node->child[first];
+  if ((hits & (hits - 1)) == 0) {
+    const int second = lowest_bit(hits);
+    const bool swap = sorted && t[first] < t[second];
+    const int far = swap ? second : first, near = swap ? first : second;
+    stack_node[*sp] = node->child[far];
+    stack_t[*sp] = t[far];
+    ++*sp;
+    return node->child[near];
+  }
   int order[8];
-  int n = 0;
-  for (int i = 0; i < 8; ++i) {
-    if (t[i] == INFINITY) continue;
+  int n = 1;
+  order[0] = first;
+  for (; hits; hits &= hits - 1) {
+    const int i = lowest_bit(hits);
     // Insertion sort by decreasing distance.
     int j = n++;
     while (sorted && j > 0 && t[order[j - 1]] < t[i]) {
@@ -153,7 +182,6 @@ FH_INLINE int order_children(float8 t_near, __global const Bvh8Node* node, int* 
     }
     order[j] = i;
   }
-  if (n == 0) return 0;
   for (int k = 0; k < n - 1; ++k) {
     stack_node[*sp] = node->child[order[k]];
     stack_t[*sp] = t[order[k]];
@@ -162,7 +190,8 @@ FH_INLINE int order_children(float8 t_near, __global const Bvh8Node* node, int* 
   return node->child[order[n - 1]];
 }
 
-// Closest hit (any_hit == false) or the first hit found (any_hit == true) in [t_min, t_max).
+// Closest hit (any_hit == false) in [t_min, t_max), or whether there is any (any_hit ==
+// true: then only .triangle counts, >= 0 for a hit).
 FH_INLINE TraceHit trace_ray(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, float3 org,
                           float3 dir, float t_min, float t_max, bool any_hit) {
   const RayPrecomp r = precompute_ray(org, dir);
@@ -181,7 +210,7 @@ FH_INLINE TraceHit trace_ray(__global const Bvh8Node* nodes, __global const Tria
       if (ref != 0) continue;
     } else {
       __global const TriangleBlock8* block = blocks + ~ref;
-      const int lane = intersect_block(&r, block, t_min, &hit.t, &hit.b1, &hit.b2);
+      const int lane = intersect_block(&r, block, t_min, &hit.t, &hit.b1, &hit.b2, any_hit);
       if (lane >= 0) {
         hit.triangle = block->id[lane];
         if (any_hit) return hit;
