@@ -46,7 +46,7 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
         alive = alive || starts;
       }
       if (!lanes_any(alive)) break;
-      FH_FOR_LANES(l) {
+      FH_EACH_LANE(l) {
         if (LANE(alive, l)) intersect_slot(nodes, blocks, LANE(p, l), ray_org, ray_dir, hit);
       }
       const ShadeOutcome o = shade_paths(params, p, alive, triangles, triangle_material, materials, light_pdf_area,

@@ -68,7 +68,7 @@ FH_INLINE void connect_light(RenderParams params, const ShadowRequest* r, lmask 
   const lvec3 d = v3_sub(offset_ray_origin(&l, v3_neg(wi)), origin);
   const lfloat dist = v3_length(d);
   const lvec3 direction = v3_scale(d, 1.0f / dist);
-  FH_FOR_LANES(k) {
+  FH_EACH_LANE(k) {
     if (!LANE(connects, k)) continue;
     if (trace_ray(nodes, blocks, v3_lane(origin, k), v3_lane(direction, k), 0.0f, LANE(dist, k) * FH_SHADOW_SHORTEN, true)
             .triangle >= 0)
