@@ -1,30 +1,6 @@
-// Ray casting: closest hit and any hit over arrays of rays stored as float4 pairs
-// (origin.xyz + tmin, direction.xyz + tmax), and the path tracer's intersect stage.
+// The path tracer's intersect stage: the closest hit of each path's ray (ray casting over
+// plain arrays of rays, for the bench and the tests, is ray_cast.cl).
 #include "intersect.h"
-
-#if !defined(FH_MEGAKERNEL)  // kernels the megakernel's program does not need
-// hits[i] = (t, b1, b2, triangle index in BVH order as bits; -1 on a miss). Per-triangle
-// data on the device is stored in that order.
-__kernel void intersect_closest(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
-                                __global const float4* ray_org, __global const float4* ray_dir,
-                                __global float4* hits, uint ray_count) {
-  const uint i = get_global_id(0);
-  if (i >= ray_count) return;
-  const float4 o = ray_org[i], d = ray_dir[i];
-  const TraceHit h = trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w, false);
-  hits[i] = (float4)(h.triangle < 0 ? INFINITY : h.t, h.b1, h.b2, as_float(h.triangle));
-}
-
-// occluded[i] = 1 if anything lies on the segment [tmin, tmax), else 0.
-__kernel void intersect_any(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
-                            __global const float4* ray_org, __global const float4* ray_dir,
-                            __global int* occluded, uint ray_count) {
-  const uint i = get_global_id(0);
-  if (i >= ray_count) return;
-  const float4 o = ray_org[i], d = ray_dir[i];
-  occluded[i] = trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w, true).triangle >= 0;
-}
-#endif
 
 // Closest hit for the ray of path slot p: reads ray_org/ray_dir, writes hit.
 FH_INLINE void intersect_slot(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, uint p,

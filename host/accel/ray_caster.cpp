@@ -4,7 +4,7 @@
 namespace fh {
 
 ProgramSpec intersectProgram(const std::string& traversalOptions) {
-  return {"intersect", {"intersect.cl"}, traversalOptions};
+  return {"ray casting", {"ray_cast.cl"}, traversalOptions};
 }
 
 DeviceBvh::DeviceBvh(DeviceContext& dc, const Bvh& bvh) {
