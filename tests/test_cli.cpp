@@ -61,14 +61,16 @@ TEST(RenderCli, StatsAndExrMetadata) {
   EXPECT_EQ(stats["nonfinite_samples"], 0);
   EXPECT_GT(stats["samples_per_second"].get<double>(), 0.0);
   EXPECT_EQ(stats["devices"].size(), 1u);
-  EXPECT_EQ(stats["rr_depth"], 3);
-  // On a CPU the automatic strategy is eight paths per work-item.
-  if (stats["devices"][0]["name"].get<std::string>().find("pthread") != std::string::npos) {
-    EXPECT_EQ(stats["devices"][0]["strategy"], "simd8");
+  EXPECT_EQ(stats["rr_depth"], 6);
+  // On a CPU the automatic strategy is the megakernel with eight paths per work-item.
+  const bool cpu = stats["devices"][0]["name"].get<std::string>().find("pthread") != std::string::npos;
+  if (cpu) {
+    EXPECT_EQ(stats["devices"][0]["strategy"], "megakernel8");
   }
   EXPECT_EQ(stats["method"], "nee");
-  for (const char* kernel : {"generate", "intersect", "shade", "shadow_connect", "accumulate"})
-    EXPECT_TRUE(stats["kernels"].contains(kernel)) << kernel;
+  const auto kernels = cpu ? std::vector<const char*>{"plan_iteration", "megakernel", "finish_iteration"}
+                           : std::vector<const char*>{"generate", "intersect", "shade", "shadow_connect", "accumulate"};
+  for (const char* kernel : kernels) EXPECT_TRUE(stats["kernels"].contains(kernel)) << kernel;
   auto img = OIIO::ImageInput::open(dir + "/a.exr");
   ASSERT_TRUE(img);
   EXPECT_EQ(img->spec().get_string_attribute("fredholm:method"), "nee");

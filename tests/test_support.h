@@ -9,8 +9,8 @@
 
 namespace fh::test {
 
-// RenderSettings{} with the strategy this run tests: FREDHOLM_TEST_STRATEGY (scalar or
-// simd8; CTest runs every rendering suite under each, tests/CMakeLists.txt), else auto.
+// RenderSettings{} with the strategy this run tests: FREDHOLM_TEST_STRATEGY (CTest runs the
+// rendering suites under several, tests/CMakeLists.txt), else auto.
 RenderSettings renderSettings();
 
 // Absolute path of a file in ../shared/scenes, or "" if the corpus is absent.

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "render/settings.h"
 #include "scene/scene.h"
 
 namespace fh {
@@ -18,7 +19,7 @@ struct RenderOptions {
   double seconds = 0.0;
   std::string method = "mis", filter = "box", env, statsFile, strategy = "auto";
   int maxDepth = 64;
-  int rrDepth = 3;
+  int rrDepth = RenderSettings{}.rrDepth;
   std::optional<size_t> wavefront;  // unset: chosen for each device
   bool allFeatures = false;
   unsigned seed = 1;

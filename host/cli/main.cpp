@@ -49,9 +49,10 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
   rendering->add_option("--wavefront", o.wavefront, "Paths in flight (default: chosen for the device)");
   rendering->add_option("--stats", o.statsFile, "Write render statistics as JSON");
   rendering->add_option("--strategy", o.strategy,
-                        "How devices run the stages: auto (by device type), scalar (one path per work-item, for "
-                        "GPUs), simd8 (eight paths per work-item in vector lanes, for CPUs), megakernel or "
-                        "megakernel8 (every stage in one kernel, one or eight paths per work-item)")
+                        "How devices run the stages: auto (by device type), scalar (a kernel per stage, one path "
+                        "per work-item; GPUs), simd8 (a kernel per stage, eight paths per work-item in vector "
+                        "lanes), megakernel or megakernel8 (every stage in one kernel, one or eight paths per "
+                        "work-item; megakernel8 for CPUs)")
       ->capture_default_str();
   rendering->add_flag("--all-features", o.allFeatures,
                       "Compile every material feature, not only the scene's (to measure specialization)");

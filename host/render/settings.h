@@ -30,7 +30,9 @@ struct RenderSettings {
   double seconds = 0.0;  // time budget: stop at the end of the pass running when it is spent
   Method method = Method::MIS;
   int maxDepth = 64;     // bounces; Russian roulette does the real work
-  int rrDepth = 3;       // Russian roulette from this bounce on
+  // Russian roulette from this bounce on: later than the minimum because roulette adds
+  // variance that, in closed scenes, costs more than the extra bounces (bench/RESULTS.md).
+  int rrDepth = 6;
   unsigned seed = 1;
   std::array<float, 3> env{0.f, 0.f, 0.f};
   PixelFilter filter = PixelFilter::Box;

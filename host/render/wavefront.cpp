@@ -72,7 +72,9 @@ ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsi
 
 Strategy strategyFor(const DeviceInfo& device, Strategy asked) {
   if (asked != Strategy::Auto) return asked;
-  return device.type == "cpu" ? Strategy::Simd8 : Strategy::Scalar;
+  // A CPU's caches favour one kernel that keeps each path's state close from stage to stage;
+  // a GPU hides memory latency with many paths and favours short, uniform kernels.
+  return device.type == "cpu" ? Strategy::Megakernel8 : Strategy::Scalar;
 }
 
 unsigned lanesOf(Strategy s) { return s == Strategy::Simd8 || s == Strategy::Megakernel8 ? 8 : 1; }
