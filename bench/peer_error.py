@@ -8,6 +8,9 @@ same axes, each image measured against one long reference with Mitsuba's compare
                       [--mitsuba-python /opt/mi-venv/bin/python] [--out bench/peers]
                       [-- EXTRA fredholm render flags]
 
+Then, at equal time, each fredholm method renders with --time set to the seconds Mitsuba
+ldsampler took for the largest spp (the issue's target: fredholm's relMSE there <= Mitsuba's).
+
 Renders run one after another (never two at once): fredholm's seconds are --stats
 `seconds` (devices ready to last pass merged, after a warm-up render per method has filled
 PoCL's kernel cache), Mitsuba's `seconds_render` (after its JIT
@@ -32,14 +35,18 @@ def relmse(python, ref, image):
     return json.loads(out.strip().splitlines()[-1])["relMSE"]
 
 
-def fredholm(method, spp, extra, workdir):
+def fredholm(method, spp, extra, workdir, seconds=None):
+    """Renders spp samples per pixel, or as many as fit in `seconds`; returns the image, the
+    seconds taken and the samples per pixel rendered."""
     image, stats = os.path.join(workdir, "f.exr"), os.path.join(workdir, "f.json")
+    budget = ["--time", str(seconds)] if seconds else []
     subprocess.run([os.path.join(ROOT, "build", "fredholm"), "render", "--width", "512", "--height", "512",
-                    "--spp", str(spp), "--method", method, "--seed", str(spp)] + CAMERA + extra +
+                    "--spp", str(spp), "--method", method, "--seed", str(spp)] + budget + CAMERA + extra +
                    ["-o", image, "--force", "--stats", stats], check=True, stdout=subprocess.DEVNULL,
                    stderr=subprocess.DEVNULL)
     with open(stats) as f:
-        return image, json.load(f)["seconds"]
+        doc = json.load(f)
+    return image, doc["seconds"], doc["samples"] // (512 * 512)
 
 
 def mitsuba(python, sampler, spp, workdir):
@@ -62,23 +69,32 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "bench", "peers"))
     opts = ap.parse_args(argv)
     os.makedirs(opts.out, exist_ok=True)
-    rows = []
+    rows, equal_time = [], []
     with tempfile.TemporaryDirectory() as workdir:
         for method in opts.methods.split(","):
             fredholm(method, 1, extra, workdir)  # PoCL compiles a kernel at its first launch: keep that out
         for spp in [int(s) for s in opts.spp.split(",")]:
             for method in opts.methods.split(","):
-                image, seconds = fredholm(method, spp, extra, workdir)
+                image, seconds, _ = fredholm(method, spp, extra, workdir)
                 rows.append(("fredholm " + method, spp, seconds, relmse(opts.mitsuba_python, opts.ref, image)))
                 print(*rows[-1], flush=True)
             for sampler in ("ldsampler", "independent"):
                 image, seconds = mitsuba(opts.mitsuba_python, sampler, spp, workdir)
                 rows.append(("mitsuba " + sampler, spp, seconds, relmse(opts.mitsuba_python, opts.ref, image)))
                 print(*rows[-1], flush=True)
+        budget = [r for r in rows if r[0] == "mitsuba ldsampler"][-1]
+        for method in opts.methods.split(","):
+            image, seconds, spp = fredholm(method, 4096, extra, workdir, seconds=budget[2])
+            equal_time.append(("fredholm " + method, spp, seconds, relmse(opts.mitsuba_python, opts.ref, image)))
+            print("equal time:", *equal_time[-1], "against mitsuba ldsampler", *budget[1:], flush=True)
     with open(os.path.join(opts.out, "cornell-peers.csv"), "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["renderer", "spp", "seconds", "relmse"])
         w.writerows(rows)
+    with open(os.path.join(opts.out, "cornell-equal-time.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["renderer", "spp", "seconds", "relmse"])
+        w.writerows([budget] + equal_time)
     plt.figure(figsize=(6.4, 4.8))
     for name in dict.fromkeys(r[0] for r in rows):
         pts = [(r[2], r[3]) for r in rows if r[0] == name]

@@ -3,7 +3,8 @@
 drifts by tens of percent between runs, so only interleaved figures compare).
 
   bench/peer_speed.py [--rounds 3] [--spp 64] [--mitsuba-python /opt/mi-venv/bin/python]
-                      [--strategies simd8,scalar] [--fredholm build/fredholm] [--baseline OLD]
+                      [--strategies megakernel8,simd8] [--rr-depths 6] [--fredholm build/fredholm]
+                      [--baseline OLD]
 
 Each round renders the Cornell box at 512x512 with at most 16 bounces (the camera of the
 issue: eye 0,1,3.5, target 0,1,0, fov 40) with fredholm `mis` under each strategy and with
@@ -21,9 +22,9 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 KERNEL_NS = {}  # runner name -> kernel -> [ns per sample, one per round]
 
 
-def fredholm(binary, strategy, spp, workdir, name=None):
+def fredholm(binary, strategy, spp, workdir, name=None, rr_depth=None):
     stats = os.path.join(workdir, "s.json")
-    choice = ["--strategy", strategy] if strategy else []
+    choice = (["--strategy", strategy] if strategy else []) + (["--rr-depth", str(rr_depth)] if rr_depth else [])
     subprocess.run([binary, "render", "--width", "512", "--height", "512", "--spp", str(spp), "--method", "mis",
                     "--eye", "0,1,3.5", "--target", "0,1,0", "--fov", "40", "--max-depth", "16",
                     ] + choice + ["-o", os.path.join(workdir, "f.pfm"), "--force", "--stats", stats],
@@ -50,12 +51,15 @@ def main():
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--spp", type=int, default=64)
     ap.add_argument("--mitsuba-python", default="/opt/mi-venv/bin/python")
-    ap.add_argument("--strategies", default="simd8,scalar")
+    ap.add_argument("--strategies", default="megakernel8,simd8")
     ap.add_argument("--fredholm", default=os.path.join(ROOT, "build", "fredholm"))
     ap.add_argument("--baseline", help="an older fredholm binary (run without --strategy)")
+    ap.add_argument("--rr-depths", default="6",
+                    help="fredholm's roulette starts to run (6 is Mitsuba's rr_depth 5: the same work per sample)")
     opts = ap.parse_args()
-    runners = {"fredholm mis " + s: (lambda s=s, w=None, n=None: fredholm(opts.fredholm, s, opts.spp, w, n))
-               for s in opts.strategies.split(",")}
+    runners = {"fredholm mis %s rr%s" % (s, rr): (lambda s=s, rr=rr, w=None, n=None:
+                                                    fredholm(opts.fredholm, s, opts.spp, w, n, rr))
+               for rr in opts.rr_depths.split(",") for s in opts.strategies.split(",")}
     if opts.baseline:
         runners["fredholm mis baseline"] = lambda w=None, n=None: fredholm(opts.baseline, None, opts.spp, w, n)
     runners["mitsuba llvm_ad_rgb"] = lambda w=None, n=None: mitsuba(opts.mitsuba_python, opts.spp, w)
@@ -72,10 +76,10 @@ def main():
     base = statistics.median(results["mitsuba llvm_ad_rgb"])
     for n in names:
         m = statistics.median(results[n])
-        print("%-22s median %.3f Msamples/s  (%s)  %.2fx Mitsuba" % (n, m, ", ".join("%.3f" % v for v in results[n]),
+        print("%-28s median %.3f Msamples/s  (%s)  %.2fx Mitsuba" % (n, m, ", ".join("%.3f" % v for v in results[n]),
                                                                       m / base))
     for n, kernels in KERNEL_NS.items():
-        print("%-22s ns/sample: %s" % (n, ", ".join("%s %.0f" % (k, statistics.median(v))
+        print("%-28s ns/sample: %s" % (n, ", ".join("%s %.0f" % (k, statistics.median(v))
                                                        for k, v in sorted(kernels.items(), key=lambda kv: -max(kv[1])))))
 
 

@@ -4,7 +4,8 @@ scenes, alternated in one run (this machine drifts by tens of percent between ru
 only interleaved figures compare).
 
   bench/strategy_speed.py [--rounds 3] [--strategies simd8,megakernel8] [--baseline OLD]
-                          [--fredholm build/fredholm] [--scenes default] -- render flags...
+                          [--fredholm build/fredholm] [--scenes default] [--current-flags F]
+                          -- render flags...
 
 Scenes are the issue 13 set by default (the bunny-in-box, Sponza under a white sky, the
 water box and Veach's scene, from ../shared/scenes) or --scenes PATH[,PATH...]. Every
@@ -40,22 +41,24 @@ def main():
     ap.add_argument("--fredholm", default=os.path.join(ROOT, "build", "fredholm"))
     ap.add_argument("--baseline", help="an older fredholm binary (run without --strategy), listed first")
     ap.add_argument("--scenes", help="comma-separated scene paths (default: the issue 13 set)")
+    ap.add_argument("--current-flags", default="",
+                    help="render flags for the current binary only (e.g. '--rr-depth 3': the baseline's roulette)")
     opts = ap.parse_args(argv)
-    runners = [("baseline", opts.baseline, None)] if opts.baseline else []
-    runners += [(s, opts.fredholm, s) for s in opts.strategies.split(",")]
+    runners = [("baseline", opts.baseline, None, [])] if opts.baseline else []
+    runners += [(s, opts.fredholm, s, opts.current_flags.split()) for s in opts.strategies.split(",")]
     scenes = [(os.path.basename(p), [os.path.abspath(p)]) for p in opts.scenes.split(",")] if opts.scenes \
         else DEFAULT_SCENES
     with tempfile.TemporaryDirectory() as workdir:
         for name, scene in scenes:
-            for _, binary, strategy in runners:
-                render(binary, strategy, scene, flags, workdir)  # warm-up
+            for _, binary, strategy, own in runners:
+                render(binary, strategy, scene, flags + own, workdir)  # warm-up
             results = {r[0]: [] for r in runners}
             for k in range(opts.rounds):
-                for label, binary, strategy in runners[k % len(runners):] + runners[:k % len(runners)]:
-                    results[label].append(render(binary, strategy, scene, flags, workdir))
+                for label, binary, strategy, own in runners[k % len(runners):] + runners[:k % len(runners)]:
+                    results[label].append(render(binary, strategy, scene, flags + own, workdir))
             first = statistics.median(results[runners[0][0]])
             print("%s (%s):" % (name, " ".join(scene + flags)))
-            for label, _, _ in runners:
+            for label, _, _, _ in runners:
                 m = statistics.median(results[label])
                 print("  %-12s median %.3f Msamples/s  (%s)  %.2fx %s" % (
                     label, m, ", ".join("%.3f" % v for v in results[label]), m / first, runners[0][0]), flush=True)
