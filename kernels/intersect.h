@@ -16,13 +16,19 @@
 #define FH_TRAVERSAL_STACK 64
 #endif
 
-// Bit i set where lane i of `lanes` is set (lanes are 0 or -1).
-FH_INLINE uint lane_bits(int8 lanes) {
-  const int8 bits = lanes & (int8)(1, 2, 4, 8, 16, 32, 64, 128);
-  const int4 a = bits.lo | bits.hi;
+// The eight lanes OR-ed together.
+FH_INLINE int or_lanes(int8 x) {
+  const int4 a = x.lo | x.hi;
   const int2 b = a.lo | a.hi;
-  return (uint)(b.x | b.y);
+  return b.x | b.y;
 }
+
+// Bit i set where lane i of `lanes` is set (lanes are 0 or -1).
+FH_INLINE uint lane_bits(int8 lanes) { return (uint)or_lanes(lanes & (int8)(1, 2, 4, 8, 16, 32, 64, 128)); }
+
+// Lane l of x, where `picked` is set in lane l only: exact for every value, -0 and NaN
+// included (bits are masked, not added).
+FH_INLINE float lane_value(float8 x, int8 picked) { return as_float(or_lanes(as_int8(x) & picked)); }
 
 // The index of the lowest set bit of m (m != 0). clz is OpenCL 1.2; ctz is not.
 FH_INLINE int lowest_bit(uint m) { return 31 - (int)clz(m & (0u - m)); }
@@ -111,12 +117,11 @@ FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8
   const float nearest = fmin(m2.x, m2.y);
   const int best = lowest_bit(lane_bits(t == (float8)(nearest)));
   *t_max = nearest;
-  float vs[8], ws[8], ds[8];
-  vstore8(v, 0, vs);
-  vstore8(w, 0, ws);
-  vstore8(det, 0, ds);
-  *b1 = vs[best] / ds[best];
-  *b2 = ws[best] / ds[best];
+  // Divided in all lanes at once and picked out in registers (a store and reload per value
+  // stalled here); the unpicked lanes' quotients, infinite or not, are dropped.
+  const int8 picked = (int8)(best) == (int8)(0, 1, 2, 3, 4, 5, 6, 7);
+  *b1 = lane_value(v / det, picked);
+  *b2 = lane_value(w / det, picked);
   return best;
 }
 

@@ -17,9 +17,13 @@ FH_INLINE float3 texture_texel(__global const float4* texels, __global const uin
   const float x = (uv.x - floor(uv.x)) * w - 0.5f, y = (1.0f - (uv.y - floor(uv.y))) * h - 0.5f;
   const float fx = floor(x), fy = floor(y);
   const float tx = x - fx, ty = y - fy;
-  const int x0 = (int)fx, y0 = (int)fy;
   const int iw = (int)info.y, ih = (int)info.z;
-  const int xa = (x0 % iw + iw) % iw, xb = (xa + 1) % iw, ya = (y0 % ih + ih) % ih, yb = (ya + 1) % ih;
+  // The wrapped texel columns and rows without integer divisions (which vector units lack):
+  // x and y lie in [-0.5, size - 0.5], so fx and fy lie in [-1, size - 1], and only -1
+  // wraps. The clamp keeps non-finite coordinates inside the texture.
+  const int xa = clamp((int)fx + (fx < 0.0f ? iw : 0), 0, iw - 1);
+  const int ya = clamp((int)fy + (fy < 0.0f ? ih : 0), 0, ih - 1);
+  const int xb = xa + 1 == iw ? 0 : xa + 1, yb = ya + 1 == ih ? 0 : ya + 1;
   __global const float4* t = texels + info.x;
   const float4 top = mix(t[ya * iw + xa], t[ya * iw + xb], tx), bottom = mix(t[yb * iw + xa], t[yb * iw + xb], tx);
   return mix(top, bottom, ty).xyz;
