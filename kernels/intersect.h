@@ -151,6 +151,12 @@ typedef struct {
   int triangle;  // index in BVH order, -1 for a miss
 } TraceHit;
 
+// A hit as the device stores it: (t, b1, b2, triangle index in BVH order as bits), t =
+// INFINITY and index -1 on a miss. Per-triangle data on the device is stored in that order.
+FH_INLINE float4 stored_hit(TraceHit h) {
+  return (float4)(h.triangle < 0 ? INFINITY : h.t, h.b1, h.b2, as_float(h.triangle));
+}
+
 // Visits the children the ray hits nearest first: returns the nearest (0 if none) and
 // pushes the others, farthest first, with their distances; among equal distances the
 // higher lane counts as nearer. Any-hit queries skip the sort (any occluder ends them, near

@@ -18,7 +18,7 @@ struct RenderOptions {
   std::optional<int> spp;  // unset: 64 (4 for --aov), or as many as --time allows
   double seconds = 0.0;
   std::string method = "mis", filter = "box", env, statsFile, strategy = "auto";
-  int maxDepth = 64;
+  int maxDepth = RenderSettings{}.maxDepth;
   int rrDepth = RenderSettings{}.rrDepth;
   std::optional<size_t> wavefront;  // unset: chosen for each device
   bool allFeatures = false;
