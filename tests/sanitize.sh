@@ -28,8 +28,7 @@ start=$SECONDS
 echo "sanitize: AddressSanitizer + UndefinedBehaviorSanitizer, fast suites and fuzzing" >&2
 configure build-asan address,undefined -DFREDHOLM_FUZZ=ON
 cmake --build build-asan --parallel "$(nproc)"
-POCL_CACHE_DIR="$PWD/build-asan/pocl-cache" FREDHOLM_CACHE_DIR="$PWD/build-asan/program-cache" \
-  ctest --test-dir build-asan -L fast --output-on-failure --timeout 900 -j"$(nproc)"
+tests/run_ctest.sh build-asan -L fast -j"$(nproc)"
 
 # A fixed seed and a fixed number of inputs (about FUZZ_SECONDS each on this project's CI
 # machine) make CI's fuzzing reproducible: it finds the same thing or nothing on every run.
@@ -53,6 +52,5 @@ fuzz image_read image 200
 echo "sanitize: ThreadSanitizer, multi-device suites" >&2
 configure build-tsan thread
 cmake --build build-tsan --parallel "$(nproc)" --target fredholm test_multi_device
-POCL_CACHE_DIR="$PWD/build-tsan/pocl-cache" FREDHOLM_CACHE_DIR="$PWD/build-tsan/program-cache" \
-  ctest --test-dir build-tsan -R "TwoDevices|MultiDeviceCli" --output-on-failure --timeout 900
+tests/run_ctest.sh build-tsan -R "TwoDevices|MultiDeviceCli"
 echo "sanitize: done in $((SECONDS - start)) s" >&2

@@ -1,5 +1,5 @@
 // The intersect kernels against a brute-force double-precision reference on the same
-// rays, for every shared scene and ray kind; watertightness on shared edges and vertices
+// rays, for every corpus scene and ray kind; watertightness on shared edges and vertices
 // of closed meshes; and no self-intersection of spawned rays at any scene scale.
 //
 // The oracle: triangles grown and shrunk by the error a float test may make in the ray's
@@ -227,8 +227,7 @@ class AgainstBruteForce : public ::testing::TestWithParam<ScenePath> {};
 void PrintTo(const ScenePath& p, std::ostream* os) { *os << p.path; }
 
 TEST_P(AgainstBruteForce, EveryRayKindAgrees) {
-  if (!test::haveSharedScenes()) GTEST_SKIP() << "../shared/scenes not present";
-  const Scene scene = loadScene(test::sharedScene(GetParam().path));
+  const Scene scene = loadScene(test::testScene(GetParam().path));
   const size_t n = GetParam().raysPerKind;
   RayCasting rc(scene);
   Camera camera = scene.hasCamera ? scene.camera : Camera{};
@@ -259,7 +258,7 @@ std::string scenePathName(const ::testing::TestParamInfo<ScenePath>& info) {
 
 // Fewer rays on the big scenes: the reference tests every triangle for every ray.
 INSTANTIATE_TEST_SUITE_P(
-    SharedScenes, AgainstBruteForce,
+    Corpus, AgainstBruteForce,
     ::testing::Values(ScenePath{"cornell-box/CornellBox-Original.obj", 4096},
                       ScenePath{"cornell-box/CornellBox-Mirror.obj", 1024},
                       ScenePath{"cornell-box/CornellBox-Empty-RG.obj", 1024},
@@ -272,11 +271,11 @@ INSTANTIATE_TEST_SUITE_P(
                       ScenePath{"cornell-box/CornellBox-Glossy-Floor.obj", 256},
                       ScenePath{"cornell-box/water.obj", 400},
                       ScenePath{"cornell-box/legacy-glossy-2011/CornellBox-Glossy.obj", 400},
-                      ScenePath{"bunny/bunny.obj", 100},
-                      ScenePath{"bunny/CornellBox-Bunny.obj", 100},
+                      ScenePath{"blob/blob.obj", 100},
+                      ScenePath{"blob/CornellBox-Blob.obj", 100},
                       ScenePath{"mori-knob/testObj.obj", 256},
-                      ScenePath{"sponza/sponza.obj", 100},
-                      ScenePath{"veach-mis/veach_mis.obj", 256}),
+                      ScenePath{"colonnade/colonnade.obj", 256},
+                      ScenePath{"veach/veach-plates.obj", 256}),
     scenePathName);
 
 // ---- Closed meshes and scene scales ----

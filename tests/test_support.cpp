@@ -23,10 +23,13 @@ RenderSettings renderSettings() {
 }
 namespace fs = std::filesystem;
 
-bool haveSharedScenes() { return fs::is_directory(FREDHOLM_SHARED_SCENES); }
+std::string generatedScene(const std::string& relative) {
+  return std::string(FREDHOLM_TEST_SCENES) + "/" + relative;
+}
 
-std::string sharedScene(const std::string& relative) {
-  return haveSharedScenes() ? std::string(FREDHOLM_SHARED_SCENES) + "/" + relative : "";
+std::string testScene(const std::string& relative) {
+  const std::string shipped = projectScene(relative);
+  return fs::exists(shipped) ? shipped : generatedScene(relative);
 }
 
 std::string projectScene(const std::string& relative) {

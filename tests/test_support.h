@@ -13,11 +13,13 @@ namespace fh::test {
 // rendering suites under several, tests/CMakeLists.txt), else auto.
 RenderSettings renderSettings();
 
-// Absolute path of a file in ../shared/scenes, or "" if the corpus is absent.
-std::string sharedScene(const std::string& relative);
-bool haveSharedScenes();
-// Absolute path of a file in this repository's scenes/ (always present).
+// Absolute path of a file in this repository's scenes/.
 std::string projectScene(const std::string& relative);
+// Absolute path of a file among the scenes generated at build time (tests/make_test_scenes.cpp),
+// which stand in for scenes that may not be redistributed; manifest.json lists their counts.
+std::string generatedScene(const std::string& relative);
+// A scene of the test corpus: shipped in scenes/ or else generated.
+std::string testScene(const std::string& relative);
 
 // A fresh empty directory under the system temp dir, removed at exit.
 std::string tempDir(const std::string& tag);
