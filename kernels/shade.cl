@@ -12,6 +12,9 @@
 #include "ray.h"
 #include "sampler.h"
 #include "surface.h"
+#if defined(FH_AOVS)
+#include "aovs.h"
+#endif
 
 #if !defined(FH_METHOD_PT) && !defined(FH_METHOD_NEE) && !defined(FH_METHOD_MIS)
 #error "build with -DFH_METHOD_PT, -DFH_METHOD_NEE or -DFH_METHOD_MIS"
@@ -45,12 +48,13 @@ typedef struct {
 } ShadeOutcome;
 
 // Shades path slots p where `active`: adds what the paths gathered at their hits to their
-// radiance and, for those that go on, writes the next ray, throughput, pdf and depth.
+// radiance and, for those that go on, writes the next ray, throughput, pdf and depth; with
+// FH_AOVS, records the first-surface layers in `aovs` (aovs.h).
 FH_INLINE ShadeOutcome shade_paths(RenderParams params, luint p, lmask active, __global const float4* triangles,
                                    __global const int* triangle_material, __global const GpuMaterial* materials,
                                    __global const float* light_pdf_area, __global const float4* normals,
                                    __global const float2* uvs, __global const float4* texels,
-                                   __global const uint4* texture_info FH_PATH_PARAMS) {
+                                   __global const uint4* texture_info, __global float4* aovs FH_PATH_PARAMS) {
   ShadeOutcome o;
   o.continues = o.light_sample = lanes_mask(false);
   // What a light-sample request needs (zero where none is made).
@@ -68,6 +72,10 @@ FH_INLINE ShadeOutcome shade_paths(RenderParams params, luint p, lmask active, _
     const lint hit_triangle = las_int(gather_w(hit, p));
     const lmask escaped = active && hit_triangle < 0, hits = active && hit_triangle >= 0;
     gathered = v3_select(escaped, v3_add(gathered, v3_mul(beta_in, v3_uniform(vload3(0, params.env)))), gathered);
+#if defined(FH_AOVS)
+    const luint aov = aov_entry(p, params.pixel_count, sample_id, local_pass);
+    record_escaped_aovs(aov, escaped && bounce == 0, aovs);
+#endif
 
     if (lanes_any(hits)) {
       const lint t = select((lint)(0), hit_triangle, hits);
@@ -100,9 +108,15 @@ FH_INLINE ShadeOutcome shade_paths(RenderParams params, luint p, lmask active, _
                                bsdf.kd);
   #endif
 
-  #if !defined(FH_METHOD_PT)
+  #if !defined(FH_METHOD_PT) || defined(FH_AOVS)
       // Two-sided shading for opaque surfaces: the normals on the viewer's side.
       const lmask front = cos_front >= 0.0f;
+  #endif
+  #if defined(FH_AOVS)
+      record_surface_aovs(aov, hits, bounce, gather_float(ray_pdf, p), h.x, &bsdf, v3_select(front, ns, v3_neg(ns)),
+                          aovs);
+  #endif
+  #if !defined(FH_METHOD_PT)
       o.light_sample = may_bounce && params.light_count > 0 && bsdf_has_smooth_lobe(&bsdf);
       r->at.position = s.position;
       r->at.magnitude = s.magnitude;
@@ -152,7 +166,7 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
                     __global const float4* triangles, __global const int* triangle_material,
                     __global const GpuMaterial* materials, __global const float* light_pdf_area,
                     __global const float4* normals, __global const float2* uvs, __global const float4* texels,
-                    __global const uint4* texture_info FH_PATH_PARAMS FH_SHADOW_PARAMS) {
+                    __global const uint4* texture_info, __global float4* aovs FH_PATH_PARAMS FH_SHADOW_PARAMS) {
   volatile __local uint scratch[2 * 3];
   const luint position = lane_positions(get_global_id(0) * FH_LANES);
   const lmask active = position < counters->ray_length[parity];
@@ -161,7 +175,7 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
   const luint p =
       lanes_any(active) ? gather_uint(ray_queue, select((luint)(LANE(position, 0)), position, active)) : (luint)(0);
   const ShadeOutcome o = shade_paths(params, p, active, triangles, triangle_material, materials, light_pdf_area,
-                                     normals, uvs, texels, texture_info FH_PATH_ARGS);
+                                     normals, uvs, texels, texture_info, aovs FH_PATH_ARGS);
 
   // Continuing paths to the next ray queue, light-sample requests to shadow_connect's,
   // finished paths to accumulate's.

@@ -21,6 +21,10 @@ std::vector<ProgramSpec> everyProgramVariant() {
   for (Method method : {Method::PT, Method::NEE, Method::MIS})
     for (const SceneFeatures& features : {SceneFeatures{}, SceneFeatures::all()})
       programs.push_back(pathTracerProgram(features, method, FH_MAX_PASS_SLOTS, traversal, Strategy::Megakernel));
+  // Recording the --aovs layers (FH_AOVS), with and without the features shade branches on.
+  for (Strategy strategy : {Strategy::Scalar, Strategy::Megakernel8})
+    for (const SceneFeatures& features : {SceneFeatures{}, SceneFeatures::all()})
+      programs.push_back(pathTracerProgram(features, Method::PT, FH_MAX_PASS_SLOTS, traversal, strategy, true));
   return programs;
 }
 

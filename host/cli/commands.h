@@ -26,6 +26,7 @@ struct RenderOptions {
   std::string cameraFile, eye, target, up;
   std::optional<float> fov;
   std::string aov;
+  std::string aovs;  // --aovs: layers written beside the image in one EXR
   std::string device;
 };
 int runRender(RenderOptions o);

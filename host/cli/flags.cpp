@@ -1,6 +1,8 @@
 // Parsing flag values.
 #include "cli/flags.h"
 
+#include <algorithm>
+#include <iterator>
 #include <sstream>
 #include <stdexcept>
 
@@ -38,6 +40,24 @@ Aov parseAov(const std::string& name) {
   if (name == "depth") return Aov::Depth;
   throw Error("--aov '" + name + "': unknown output (use albedo, normal or depth)");
 }
+
+std::vector<std::string> parseAovLayers(const std::string& list) {
+  static const char* const known[] = {"albedo", "normal", "depth", "variance", "spp"};
+  std::vector<std::string> layers;
+  std::istringstream in(list);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (std::find(std::begin(known), std::end(known), item) == std::end(known))
+      throw Error("--aovs '" + list + "': unknown layer '" + item + "' (use albedo, normal, depth, variance, spp)");
+    if (std::find(layers.begin(), layers.end(), item) != layers.end())
+      throw Error("--aovs '" + list + "': layer '" + item + "' is named twice");
+    layers.push_back(item);
+  }
+  if (layers.empty() || list.back() == ',') throw Error("--aovs '" + list + "': expected a comma-separated list of layers");
+  return layers;
+}
+
+bool isSurfaceAov(const std::string& layer) { return layer == "albedo" || layer == "normal" || layer == "depth"; }
 
 std::array<float, 3> parseVec3Flag(const std::string& flag, const std::string& text) {
   std::array<float, 3> v{};

@@ -63,6 +63,10 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
   rendering->add_option("--up", o.up, "Camera up vector x,y,z");
   rendering->add_option("--fov", o.fov, "Vertical field of view in degrees");
   rendering->add_option("--aov", o.aov, "Debug view instead of light transport: albedo, normal or depth");
+  rendering->add_option("--aovs", o.aovs,
+                        "Layers written beside the image in one EXR, from the same render: albedo, normal "
+                        "(first non-specular surface), depth (camera ray), variance (of each pixel's mean), "
+                        "spp; e.g. albedo,normal,depth");
   rendering->add_option("--device", o.device,
                         std::string("Devices sharing the render (--aov: one): ") + kDeviceSpec);
   return rendering;

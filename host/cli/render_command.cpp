@@ -2,6 +2,7 @@
 // every device --device selects, and the image with its metadata.
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -118,6 +119,33 @@ RenderResult renderDebugView(Aov mode, const std::vector<DeviceInfo>& devices, c
   return r;
 }
 
+// The film's image with the --aovs layers, named as compositors and denoisers read them.
+Image imageWithLayers(const Film& film, const std::vector<std::string>& layers) {
+  Image image = film.image();
+  for (const std::string& name : layers) {
+    ImageLayer layer{name, {}, {}};
+    if (name == "albedo") {
+      layer.channels = {"R", "G", "B"};
+      layer.values = film.albedo();
+    } else if (name == "normal") {
+      layer.channels = {"X", "Y", "Z"};
+      layer.values = film.normal();
+    } else if (name == "depth") {
+      layer.channels = {"Z"};
+      layer.values = film.depth();
+    } else if (name == "variance") {
+      layer.channels = {"R", "G", "B"};
+      for (size_t p = 0; p < film.pixels(); ++p)
+        for (double v : film.varianceOfMean(p)) layer.values.push_back(float(v));
+    } else {  // spp
+      layer.channels = {"Y"};
+      for (size_t p = 0; p < film.pixels(); ++p) layer.values.push_back(float(film.count(p)));
+    }
+    image.layers.push_back(std::move(layer));
+  }
+  return image;
+}
+
 void reportDevices(const RenderResult& r) {
   for (const auto& w : r.warnings) std::cerr << "fredholm: warning: " << w << "\n";
   for (const auto& d : r.stats.devices)
@@ -135,9 +163,14 @@ int runRender(RenderOptions o) {
   settings.stop = &installInterruptHandlers();
   const bool debugView = !o.aov.empty();
   const Aov aov = debugView ? parseAov(o.aov) : Aov::Albedo;
+  const std::vector<std::string> layers = o.aovs.empty() ? std::vector<std::string>{} : parseAovLayers(o.aovs);
+  if (debugView && !layers.empty()) throw Error("--aov (a debug view) and --aovs (layers beside the image): pick one");
+  for (const auto& layer : layers) settings.surfaceAovs |= isSurfaceAov(layer);
   // An explicit -o is never overwritten without --force; the default name steps aside.
-  if (o.output.empty()) o.output = firstFreeName("fredholm.png");
+  if (o.output.empty()) o.output = firstFreeName(layers.empty() ? "fredholm.png" : "fredholm.exr");
   checkOutputPath(o.output, o.force);
+  if (!layers.empty() && std::filesystem::path(o.output).extension() != ".exr")
+    throw Error("--aovs: layers are written into one EXR; -o '" + o.output + "' is not an .exr file");
   if (!o.statsFile.empty()) checkOutputFile(o.statsFile, o.force, "--stats");
   const auto devices = selectDevices(listDevices(), o.device);
   if (!o.aov.empty() && devices.size() > 1)
@@ -164,21 +197,23 @@ int runRender(RenderOptions o) {
                             {"device", devicesUsed}, {"seed", std::to_string(o.seed)},
                             {"seconds", formatSeconds(seconds)}, {"filter", o.filter},
                             {"max_depth", std::to_string(o.maxDepth)}};
+  if (!layers.empty()) metadata["aovs"] = o.aovs;
+  const Image image = imageWithLayers(r.film, layers);
   const std::string passes = std::to_string(r.stats.samples / r.film.pixels()) + " passes";
   if (r.stopped) {
     const int signal = settings.stop->load();
     if (r.stats.samples == 0) throw Interrupted("before any pass was finished; nothing written", signal);
     metadata["incomplete"] = "interrupted by signal " + std::to_string(signal);
-    writeImage(o.output, r.film.image(), metadata);
+    writeImage(o.output, image, metadata);
     throw Interrupted("wrote the " + passes + " finished so far to " + o.output, signal);
   }
   if (!r.complete) {
     metadata["incomplete"] = "every device failed";
-    writeImage(o.output, r.film.image(), metadata);
+    writeImage(o.output, image, metadata);
     throw Error("every device failed before the render was complete; wrote the " + passes +
                 " finished so far to " + o.output);
   }
-  writeImage(o.output, r.film.image(), metadata);
+  writeImage(o.output, image, metadata);
   std::cerr << "fredholm: rendered " << scene.sourcePath << " (" << scene.triangleCount() << " triangles, "
             << scene.lights.size() << " emissive; " << (o.allFeatures ? "all features" : sceneFeatures(scene).describe())
             << ") with " << method << ", " << o.width << "x" << o.height << ", " << spp << " spp on " << devicesUsed

@@ -115,6 +115,22 @@ std::string firstFreeName(const std::string& path) {
 
 namespace {
 
+// The image's R, G, B then every layer's channels, per pixel.
+std::vector<float> interleaveLayers(const Image& image, size_t channels) {
+  if (image.layers.empty()) return image.rgb;
+  const size_t pixels = size_t(image.width) * size_t(image.height);
+  std::vector<float> out;
+  out.reserve(pixels * channels);
+  for (size_t p = 0; p < pixels; ++p) {
+    out.insert(out.end(), image.rgb.begin() + long(3 * p), image.rgb.begin() + long(3 * p + 3));
+    for (const ImageLayer& layer : image.layers) {
+      const size_t n = layer.channels.size();
+      out.insert(out.end(), layer.values.begin() + long(n * p), layer.values.begin() + long(n * p + n));
+    }
+  }
+  return out;
+}
+
 // Encodes `image` into the file `path` by its extension.
 void encodeImage(const std::string& path, const Image& image, ImageEncoding encoding,
                  const std::map<std::string, std::string>& metadata) {
@@ -123,14 +139,20 @@ void encodeImage(const std::string& path, const Image& image, ImageEncoding enco
   auto out = OIIO::ImageOutput::create(path);
   if (!out) throw Error(OIIO::geterror());
   const bool isFloat = encoding == ImageEncoding::LinearFloat;
-  OIIO::ImageSpec spec(image.width, image.height, 3, isFloat ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+  if (!image.layers.empty() && extensionOf(path) != ".exr") throw Error("image layers need an EXR file");
+  std::vector<std::string> channelNames = {"R", "G", "B"};
+  for (const ImageLayer& layer : image.layers)
+    for (const std::string& c : layer.channels) channelNames.push_back(layer.name + "." + c);
+  OIIO::ImageSpec spec(image.width, image.height, int(channelNames.size()),
+                       isFloat ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+  spec.channelnames = channelNames;
   for (const auto& [key, value] : metadata) spec.attribute("fredholm:" + key, value);
   spec.attribute("Software", "fredholm " FREDHOLM_VERSION);
   if (!isFloat) spec.attribute("oiio:ColorSpace", "sRGB");
   if (!out->open(path, spec)) throw Error(out->geterror());
   bool ok;
   if (isFloat) {
-    ok = out->write_image(OIIO::TypeDesc::FLOAT, image.rgb.data());
+    ok = out->write_image(OIIO::TypeDesc::FLOAT, interleaveLayers(image, channelNames.size()).data());
   } else {
     std::vector<unsigned char> bytes(image.rgb.size());
     for (size_t i = 0; i < bytes.size(); ++i)

@@ -8,9 +8,18 @@
 
 namespace fh {
 
+// Further channels written beside the image's R, G, B (EXR only), named `name.channel`
+// as compositors and denoisers expect them (albedo.R, normal.X, depth.Z).
+struct ImageLayer {
+  std::string name;
+  std::vector<std::string> channels;
+  std::vector<float> values;  // channels.size() per pixel, in the image's pixel order
+};
+
 struct Image {
   int width = 0, height = 0;
   std::vector<float> rgb;  // linear radiance, 3 floats per pixel, row-major from the top-left
+  std::vector<ImageLayer> layers;
 };
 
 enum class ImageEncoding { LinearFloat, Srgb8 };

@@ -10,11 +10,16 @@
 
 namespace fh {
 
+// A pass's first-surface layers per pixel, after its radiance (kernels/aovs.h): albedo rgb,
+// a flag, normal xyz, the camera ray's hit distance.
+constexpr size_t kAovFloatsPerPixel = 8;
+
 struct Film {
   Film() = default;
-  Film(int w, int h);
+  Film(int w, int h, bool surfaceAovs = false);
 
-  // Adds one pass: per pixel (rgb, 1), pixel-major, as the device's pass buffer holds it.
+  // Adds one pass: per pixel (rgb, 1), pixel-major, as the device's pass buffer holds it,
+  // then, for a film with surface AOVs, kAovFloatsPerPixel per pixel.
   void addPass(const std::vector<float>& samples);
 
   Image image() const;  // the mean per pixel
@@ -23,8 +28,21 @@ struct Film {
   double count(size_t pixel) const { return sum[4 * pixel + 3]; }
   size_t pixels() const { return size_t(width) * size_t(height); }
 
+  // The first-surface layers, means per pixel: albedo and normal over all samples (zero
+  // where a sample saw nothing; the normal is not renormalized), depth over the samples that
+  // hit something (kNoDepth where none did). Empty without surface AOVs.
+  std::vector<float> albedo() const;
+  std::vector<float> normal() const;
+  std::vector<float> depth() const;
+  bool hasSurfaceAovs() const { return !aovSum.empty(); }
+
   int width = 0, height = 0;
   std::vector<double> sum, sumSq;
+  // Per pixel: albedo rgb, normal xyz, depth, samples that hit (sums in pass order).
+  std::vector<double> aovSum;
 };
+
+// The depth of a pixel where nothing was hit (as Cycles writes its background's).
+constexpr float kNoDepth = 1e10f;
 
 }  // namespace fh

@@ -16,7 +16,7 @@ PassPool::PassPool(const RenderSettings& s, int workers)
       start_(std::chrono::steady_clock::now()),
       outstanding_(size_t(workers)),
       done_(size_t(workers), 0),
-      film_(s.width, s.height),
+      film_(s.width, s.height, s.surfaceAovs),
       progress_(s.progress),
       merger_([this] { mergeInOrder(); }) {}
 

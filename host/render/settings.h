@@ -40,6 +40,9 @@ struct RenderSettings {
   bool progress = false;
   bool allFeatures = false;  // compile every material feature, not only the scene's (benchmarks)
   Strategy strategy = Strategy::Auto;  // Auto: chosen per device type
+  // Record each sample's first-surface layers (albedo, normal, depth: kernels/aovs.h) in the
+  // same render; the film then keeps them beside the radiance (render/film.h).
+  bool surfaceAovs = false;
   // Set (non-zero) to stop early, as Ctrl-C does: passes in flight are dropped, those
   // finished are kept. Null: never.
   const std::atomic<int>* stop = nullptr;

@@ -59,15 +59,15 @@ gpu::RenderParams renderParams(const RenderSettings& s, const Camera& camera, un
 }  // namespace
 
 ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsigned passSlots,
-                              const std::string& traversalOptions, Strategy strategy) {
+                              const std::string& traversalOptions, Strategy strategy, bool surfaceAovs) {
   const char* methodFlag = method == Method::PT ? "PT" : method == Method::NEE ? "NEE" : "MIS";
   const bool mega = isMegakernel(strategy);
   return {std::string("path tracer (") + methodName(method) + features.buildOptions() + ", " + strategyName(strategy) +
-              ")",
+              (surfaceAovs ? ", aovs" : "") + ")",
           mega ? std::vector<std::string>{stageInfo(Stage::PlanIteration).file, kMegakernel.file} : stageFiles(),
           traversalOptions + features.buildOptions() + " -DFH_PASS_SLOTS=" + std::to_string(passSlots) +
               " -DFH_METHOD_" + methodFlag + " -DFH_LANES=" + std::to_string(lanesOf(strategy)) +
-              (mega ? " -DFH_MEGAKERNEL" : "")};
+              (mega ? " -DFH_MEGAKERNEL" : "") + (surfaceAovs ? " -DFH_AOVS" : "")};
 }
 
 Strategy strategyFor(const DeviceInfo& device, Strategy asked) {
@@ -98,7 +98,8 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
       method_(s.method),
       strategy_(strategyFor(dc.info, s.strategy)),
       scene_(dc, scene, bvh, s.allFeatures ? SceneFeatures::all() : sceneFeatures(scene)),
-      pixels_(unsigned(s.width) * unsigned(s.height)) {
+      pixels_(unsigned(s.width) * unsigned(s.height)),
+      surfaceAovs_(s.surfaceAovs) {
   // No more paths than the passes in flight can ever hold.
   const size_t most = roundUp(size_t(FH_MAX_PASS_SLOTS) * pixels_, kLocalSize);
   wavefront_ = std::min(s.wavefront ? s.wavefront : defaultWavefront(dc.info, pixels_), most);
@@ -116,7 +117,7 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
 
   const cl::Program program = buildProgram(
       dc.context, dc.info.device, pathTracerProgram(scene_.features, s.method, passSlots_, scene_.bvh.traversalOptions(),
-                                                         strategy_));
+                                                         strategy_, surfaceAovs_));
   // The megakernel's program holds only the books' kernels besides its own: its stages are
   // functions it calls (a kernel per stage would double PoCL's compile time for nothing).
   for (auto& kernels : kernels_)
@@ -148,6 +149,8 @@ void WavefrontPipeline::allocateBuffers(const std::vector<float>& filterTable) {
   queues_.counters = buffer(sizeof counters_, "queue counters", &counters_);
   passBuffers_ = buffer(size_t(passSlots_) * pixels_ * 16, "pass buffers");
   FH_CL(dc_.queue.enqueueFillBuffer(passBuffers_, 0u, 0, size_t(passSlots_) * pixels_ * 16));
+  // Every sample writes its AOV entry at its first vertex: no clearing needed.
+  aovBuffers_ = buffer(surfaceAovs_ ? size_t(passSlots_) * pixels_ * kAovFloatsPerPixel * 4 : 16, "AOV buffers");
   filterTable_ = allocateBuffer(dc_.context, dc_.info.device, CL_MEM_READ_ONLY, filterTable.size() * 4,
                                 "filter table", filterTable.data());
   passTableBuffer_ = buffer(passTable_.size() * 4, "pass table");
@@ -169,7 +172,7 @@ void WavefrontPipeline::bindArguments(unsigned parity) {
         << params_ << queues_.counters << parity << queues_.freeSlots << filterTable_ << passTableBuffer_
         << sc.bvh.nodes() << sc.bvh.blocks() << sc.bvh.triangles() << sc.triangleMaterial << sc.materials
         << sc.lightCdf << sc.lightTriangle << sc.lightPdfArea << sc.normals << sc.uvs << sc.texels << sc.textureInfo
-        << passBuffers_ << paths_;
+        << passBuffers_ << aovBuffers_ << paths_;
     return;
   }
   args(Stage::Generate) << params_ << queues_.counters << queues_.freeSlots << rays << filterTable_
@@ -178,7 +181,7 @@ void WavefrontPipeline::bindArguments(unsigned parity) {
                          << paths_.ray_org << paths_.ray_dir << paths_.hit;
   args(Stage::Shade) << params_ << rays << nextRays << queues_.finished << queues_.counters << parity
                      << sc.bvh.triangles() << sc.triangleMaterial << sc.materials << sc.lightPdfArea << sc.normals
-                     << sc.uvs << sc.texels << sc.textureInfo << paths_ << shadowRequests_;
+                     << sc.uvs << sc.texels << sc.textureInfo << aovBuffers_ << paths_ << shadowRequests_;
   args(Stage::ShadowConnect) << params_ << queues_.counters << sc.bvh.nodes() << sc.bvh.blocks()
                              << sc.bvh.triangles() << sc.triangleMaterial << sc.materials << sc.lightCdf
                              << sc.lightTriangle << sc.lightPdfArea << paths_ << shadowRequests_;
@@ -249,7 +252,10 @@ bool WavefrontPipeline::passComplete(uint64_t local) const {
 
 void WavefrontPipeline::takePass(uint64_t local, std::vector<float>& samples) {
   const size_t slot = size_t(local % passSlots_), bytes = size_t(pixels_) * 16;
-  samples.resize(size_t(pixels_) * 4);
+  const size_t aovBytes = surfaceAovs_ ? size_t(pixels_) * kAovFloatsPerPixel * 4 : 0;
+  samples.resize((bytes + aovBytes) / 4);
+  if (aovBytes)
+    FH_CL(dc_.queue.enqueueReadBuffer(aovBuffers_, CL_FALSE, slot * aovBytes, aovBytes, samples.data() + bytes / 4));
   FH_CL(dc_.queue.enqueueReadBuffer(passBuffers_, CL_TRUE, slot * bytes, bytes, samples.data()));
   FH_CL(dc_.queue.enqueueFillBuffer(passBuffers_, 0u, slot * bytes, bytes));
   // Safe to reset: the next pass using this slot has not been granted yet.

@@ -12,6 +12,7 @@
 
 #include "kernels/path_state.h"
 #include "render/device_scene.h"
+#include "render/film.h"
 #include "render/render_stats.h"
 #include "render/settings.h"
 #include "render/stages.h"
@@ -43,9 +44,10 @@ struct SlotQueues {
 
 // The path tracer's program for a scene's features, a method, the passes in flight and a
 // strategy (the paths each work-item carries, FH_LANES; for the megakernels, the books and
-// megakernel.cl instead of the stage files).
+// megakernel.cl instead of the stage files); with surfaceAovs, shade records the
+// first-surface layers (FH_AOVS).
 ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsigned passSlots,
-                              const std::string& traversalOptions, Strategy strategy);
+                              const std::string& traversalOptions, Strategy strategy, bool surfaceAovs = false);
 
 // The strategy a device runs: the one asked for, or for Auto, eight lanes on a CPU and
 // one path per work-item elsewhere.
@@ -80,7 +82,8 @@ class WavefrontPipeline {
   const gpu::WavefrontCounters& readCounters();
   // Whether local pass `local` is complete, as of the last readCounters().
   bool passComplete(uint64_t local) const;
-  // Reads a complete pass's samples (rgb, 1 per pixel) and frees its slot for a new pass.
+  // Reads a complete pass's samples (rgb, 1 per pixel; then, with surface AOVs, the pass's
+  // kAovFloatsPerPixel per pixel) and frees its slot for a new pass.
   void takePass(uint64_t local, std::vector<float>& samples);
 
   // This device's counts so far (samples are the film's to count) and stage times.
@@ -121,6 +124,8 @@ class WavefrontPipeline {
   ShadowRequestBuffers shadowRequests_;
   SlotQueues queues_;
   cl::Buffer passBuffers_, filterTable_, passTableBuffer_;
+  bool surfaceAovs_;
+  cl::Buffer aovBuffers_;  // per pass slot and pixel, kernels/aovs.h (a placeholder without AOVs)
   std::vector<uint32_t> passTable_;  // global pass of each local pass (stable storage for writes)
   uint32_t sampleLimit_ = 0;         // local samples that may start (stable storage for writes)
   gpu::WavefrontCounters counters_{};
