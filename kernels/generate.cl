@@ -16,7 +16,7 @@ FH_INLINE void start_sample(RenderParams params, luint j, luint slot, lmask acti
   const luint pixel = j % params.pixel_count, device_pass = j / params.pixel_count;
   const luint pass = gather_uint(pass_table, device_pass);
   const luint k = pass * params.pixel_count + pixel;
-  const PixelSampler sampler = pixel_sampler(params.seed, k, params.pixel_count);
+  const PixelSampler sampler = pixel_sampler(params.seed, k, params.pixel_count, params.replicates);
   const lvec2 u = sample_2d(&sampler, (luint)(FH_DIM_PIXEL));
   const uint width = (uint)params.camera.width;
   const lfloat px = lconvert_float(pixel % width) + 0.5f + filter_offset(filter_table, params.filter_table_size, u.x);

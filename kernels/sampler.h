@@ -55,10 +55,16 @@ typedef struct {
   luint index_reversed;
 } PixelSampler;
 
-FH_INLINE PixelSampler pixel_sampler(uint seed, luint sample_id, uint pixel_count) {
+// With replicates == 2 (a noise target: host/render/film.h), a pixel's even and odd passes
+// are two sequences under independent scramblings, each a net in its own right: the
+// difference of their means is an unbiased estimate of the image's error, which the
+// correlated points of one sequence do not give. replicates == 1: one sequence.
+FH_INLINE PixelSampler pixel_sampler(uint seed, luint sample_id, uint pixel_count, uint replicates) {
   PixelSampler s;
-  s.pixel_seed = hash_combine((luint)(seed), sample_id % pixel_count);
-  s.index_reversed = reverse_bits_u32(sample_id / pixel_count);
+  const luint pass = sample_id / pixel_count, shift = (luint)(replicates - 1u);
+  const luint replicate = pass & shift;
+  s.pixel_seed = hash_combine((luint)(seed) + replicate * 0x9e3779b9u, sample_id % pixel_count);
+  s.index_reversed = reverse_bits_u32(pass >> shift);
   return s;
 }
 

@@ -22,7 +22,8 @@ FH_INLINE void connect_light(RenderParams params, const ShadowRequest* r, lmask 
   const luint p = r->path;
   const SurfacePoint s = r->at;  // its normal: the geometric normal on the viewer's side
   const lvec3 n = r->shading_normal;  // same side
-  const PixelSampler sampler = pixel_sampler(params.seed, gather_uint(sample_id, p), params.pixel_count);
+  const PixelSampler sampler =
+      pixel_sampler(params.seed, gather_uint(sample_id, p), params.pixel_count, params.replicates);
   const luint dim = r->depth * FH_DIMS_PER_BOUNCE;
 
   // Connect from the point just off the surface that BSDF-sampled rays also start from:

@@ -78,7 +78,7 @@ typedef struct {
   uint light_count;
   uint filter_table_size; // entries of the pixel filter's inverse CDF
   float filter_radius;
-  uint pad0;
+  uint replicates;        // 1, or 2: even and odd passes are independently scrambled sequences
 } RenderParams;
 
 // The wavefront's queue lengths and books, one struct in one device buffer. The device

@@ -97,6 +97,24 @@ TEST_F(TwoDevices, DeterministicForASeedAndDeviceList) {
   EXPECT_EQ(a.film.sumSq, b.film.sumSq);
 }
 
+// A noise target ends the render at the first pass count whose film meets it, whichever
+// devices rendered the passes and however many more were in flight: the same image as on
+// one device.
+TEST_F(TwoDevices, ANoiseTargetStopsAtTheSamePassAsOneDevice) {
+  const auto all = devices();
+  ASSERT_GE(all.size(), 2u);
+  settings.spp = 4096;
+  settings.noise = 3e-3;
+  const RenderResult multi = render(all, scene, bvh, scene.camera, settings);
+  const RenderResult one = render({all[0]}, scene, bvh, scene.camera, settings);
+  ASSERT_TRUE(multi.complete);
+  EXPECT_GT(multi.film.passes(), uint64_t(kNoiseMinPasses));
+  EXPECT_LT(multi.film.passes(), 4096u);
+  EXPECT_LE(multi.film.estimatedRelMse(), settings.noise);
+  EXPECT_EQ(multi.film.passes(), one.film.passes());
+  EXPECT_EQ(multi.film.sum, one.film.sum);
+}
+
 TEST_F(TwoDevices, AFailingDeviceLosesNothingAndCountsNothingTwice) {
   const auto all = devices();
   const RenderResult reference = render(all, scene, bvh, scene.camera, settings);

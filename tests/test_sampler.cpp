@@ -16,9 +16,9 @@ namespace fh {
 namespace {
 
 const char* kTestKernels = R"CL(
-__kernel void draw(uint seed, uint pixel_count, uint dimension, uint one_d, __global float2* out) {
+__kernel void draw(uint seed, uint pixel_count, uint dimension, uint one_d, uint replicates, __global float2* out) {
   const uint i = get_global_id(0);
-  const PixelSampler s = pixel_sampler(seed, i, pixel_count);
+  const PixelSampler s = pixel_sampler(seed, i, pixel_count, replicates);
   const lvec2 u = sample_2d(&s, dimension);
   out[i] = one_d ? (float2)(sample_1d(&s, dimension), 0.0f) : (float2)(u.x, u.y);
 }
@@ -31,11 +31,12 @@ class PixelSamplerOnDevice : public ::testing::Test {
       buildProgramFromSource(dc.context, dc.info.device, assembleKernelSources({"sampler.h"}) + kTestKernels, "");
 
   // Samples 0 .. passes-1 of every pixel: result[pass * pixels + pixel].
-  std::vector<float> draw(unsigned seed, unsigned pixels, unsigned passes, unsigned dimension, bool oneD = false) {
+  std::vector<float> draw(unsigned seed, unsigned pixels, unsigned passes, unsigned dimension, bool oneD = false,
+                          unsigned replicates = 1) {
     const size_t n = size_t(pixels) * passes;
     cl::Buffer out = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, n * 8, "samples");
     cl::Kernel k = createKernel(program, "draw");
-    setKernelArgs(k, seed, pixels, dimension, cl_uint(oneD), out);
+    setKernelArgs(k, seed, pixels, dimension, cl_uint(oneD), cl_uint(replicates), out);
     FH_CL(dc.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n), cl::NDRange(64)));
     std::vector<float> v(n * 2);
     FH_CL(dc.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * 8, v.data()));
@@ -64,6 +65,38 @@ TEST_F(PixelSamplerOnDevice, EveryPowerOfTwoPrefixIsANet) {
         EXPECT_EQ(intervals.size(), n) << "1D dimension " << dimension << " pixel " << pixel << " 2^" << k;
       }
   }
+}
+
+// Two replicates (a noise target): the even passes are the one-sequence sampler's first
+// passes, the odd ones a sequence of their own, each a net, and the two are uncorrelated
+// across pixels (independent scramblings), which is what makes their difference an
+// unbiased error estimate (host/render/film.h).
+TEST_F(PixelSamplerOnDevice, TwoReplicatesAreTwoIndependentNets) {
+  const unsigned pixels = 4096, passes = 64, dimension = 4;
+  const std::vector<float> one = draw(5, pixels, passes / 2, dimension);
+  const std::vector<float> two = draw(5, pixels, passes, dimension, false, 2);
+  auto at = [&](const std::vector<float>& v, unsigned pass, unsigned pixel, int axis) {
+    return v[2 * (size_t(pass) * pixels + pixel) + size_t(axis)];
+  };
+  for (unsigned pass = 0; pass < passes / 2; ++pass)
+    for (unsigned pixel : {0u, 9u, 4095u}) ASSERT_EQ(at(two, 2 * pass, pixel, 0), at(one, pass, pixel, 0));
+  for (unsigned replicate = 0; replicate < 2; ++replicate)
+    for (unsigned pixel : {1u, 77u}) {
+      std::set<unsigned> cells;  // 32 points in 32 cells of 1/4 x 1/8
+      for (unsigned j = 0; j < passes / 2; ++j)
+        cells.insert(unsigned(at(two, 2 * j + replicate, pixel, 0) * 4.f) * 8u +
+                     unsigned(at(two, 2 * j + replicate, pixel, 1) * 8.f));
+      EXPECT_EQ(cells.size(), passes / 2) << "replicate " << replicate << " pixel " << pixel;
+    }
+  // Correlation of the replicates' first samples across pixels: ~N(0, 1/sqrt(pixels)).
+  double sxy = 0, sx = 0, sy = 0, sxx = 0, syy = 0;
+  for (unsigned p = 0; p < pixels; ++p) {
+    const double x = at(two, 0, p, 0), y = at(two, 1, p, 0);
+    sx += x, sy += y, sxy += x * y, sxx += x * x, syy += y * y;
+  }
+  const double n = pixels, r = (sxy / n - sx * sy / (n * n)) /
+                               std::sqrt((sxx / n - sx * sx / (n * n)) * (syy / n - sy * sy / (n * n)));
+  EXPECT_LT(std::fabs(r), 4.0 / std::sqrt(n));
 }
 
 // A pixel's first two samples lie in opposite halves of every dimension (the net), but

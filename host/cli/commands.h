@@ -17,6 +17,7 @@ struct RenderOptions {
   int width = 512, height = 512;
   std::optional<int> spp;  // unset: 64 (4 for --aov), or as many as --time allows
   double seconds = 0.0;
+  double noise = 0.0;  // --noise: the estimated relMSE to stop at; 0: none
   std::string method = "mis", filter = "box", env, statsFile, strategy = "auto";
   int maxDepth = RenderSettings{}.maxDepth;
   int rrDepth = RenderSettings{}.rrDepth;

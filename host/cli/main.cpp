@@ -37,6 +37,9 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
   rendering->add_option("--time", o.seconds, "Time budget in seconds (finishes the pass running then)");
   rendering->add_option("--method", o.method, "pt (BRDF sampling), nee (light sampling) or mis (both)")
       ->capture_default_str();
+  rendering->add_option("--noise", o.noise,
+                        "Stop once the image's relMSE, estimated from each pixel's sample variance, is at most "
+                        "this (e.g. 1e-3); --spp and --time still cap the render");
   rendering->add_option("--max-depth", o.maxDepth, "Most bounces (Russian roulette ends most paths sooner)")
       ->capture_default_str();
   rendering->add_option("--rr-depth", o.rrDepth,

@@ -23,6 +23,12 @@
 namespace fh {
 namespace {
 
+std::string formatScientific(double v) {
+  std::ostringstream out;
+  out << std::scientific << std::setprecision(3) << v;
+  return out.str();
+}
+
 std::string formatSeconds(double s) {
   std::ostringstream out;
   out << std::fixed << std::setprecision(2) << s;
@@ -58,7 +64,7 @@ Camera chooseCamera(const RenderOptions& o, const Scene& scene) {
 }
 
 // Every flag that does not need the scene, checked; 64 spp by default (4 for --aov), or
-// with --time and no --spp as many as the time allows (a render numbers its samples in
+// with --time or --noise and no --spp as many as they take (a render numbers its samples in
 // 32 bits, so at most that many).
 RenderSettings settingsFrom(const RenderOptions& o) {
   RenderSettings s;
@@ -74,6 +80,7 @@ RenderSettings settingsFrom(const RenderOptions& o) {
                 " is more than the 268 million pixels fredholm renders in one image");
   if (o.spp && *o.spp < 1) throw Error("--spp must be at least 1");
   if (!std::isfinite(o.seconds) || o.seconds < 0) throw Error("--time must be a finite number of seconds");
+  if (!std::isfinite(o.noise) || o.noise < 0) throw Error("--noise must be a finite, non-negative relMSE (e.g. 1e-3; 0: no target)");
   if (o.maxDepth < 1) throw Error("--max-depth must be at least 1");
   if (o.rrDepth < 1) throw Error("--rr-depth must be at least 1");
   if (o.wavefront && *o.wavefront < kLocalSize) throw Error("--wavefront must be at least 64");
@@ -81,9 +88,10 @@ RenderSettings settingsFrom(const RenderOptions& o) {
   s.width = o.width;
   s.height = o.height;
   s.spp = o.spp ? *o.spp
-                : (o.seconds > 0 ? int(std::min<uint64_t>(1 << 20, 0xFFFFFFFFull / pixels))
+                : (o.seconds > 0 || o.noise > 0 ? int(std::min<uint64_t>(1 << 20, 0xFFFFFFFFull / pixels))
                                  : (o.aov.empty() ? 64 : 4));
   s.seconds = o.seconds;
+  s.noise = o.noise;
   s.maxDepth = o.maxDepth;
   s.rrDepth = o.rrDepth;
   s.seed = o.seed;
@@ -191,13 +199,16 @@ int runRender(RenderOptions o) {
     writeTextAtomically(o.statsFile, "--stats", statsJson(r.stats, settings) + "\n");
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const double spp = double(r.stats.samples) / double(r.film.pixels());
+  // The film's samples per pixel: a noise target drops the passes finished past it.
+  const double spp = debugView ? double(r.stats.samples) / double(r.film.pixels()) : r.film.count(0);
+  const double noise = debugView ? 0.0 : r.film.estimatedRelMse();
   const std::string devicesUsed = r.stats.contributors();
   std::map<std::string, std::string> metadata = {{"scene", scene.sourcePath}, {"spp", formatSeconds(spp)}, {"method", method},
                             {"device", devicesUsed}, {"seed", std::to_string(o.seed)},
                             {"seconds", formatSeconds(seconds)}, {"filter", o.filter},
                             {"max_depth", std::to_string(o.maxDepth)}};
   if (!layers.empty()) metadata["aovs"] = o.aovs;
+  if (!debugView) metadata["estimated_relmse"] = formatScientific(noise);
   const Image image = imageWithLayers(r.film, layers);
   const std::string passes = std::to_string(r.stats.samples / r.film.pixels()) + " passes";
   if (r.stopped) {
@@ -218,6 +229,10 @@ int runRender(RenderOptions o) {
             << scene.lights.size() << " emissive; " << (o.allFeatures ? "all features" : sceneFeatures(scene).describe())
             << ") with " << method << ", " << o.width << "x" << o.height << ", " << spp << " spp on " << devicesUsed
             << " in " << formatSeconds(seconds) << " s\n";
+  if (settings.noise > 0)
+    std::cerr << "fredholm: estimated relMSE " << formatScientific(noise)
+              << (noise <= settings.noise ? " meets" : " has not reached") << " --noise " << formatScientific(settings.noise)
+              << (noise <= settings.noise ? "" : " (stopped by --spp or --time)") << "\n";
   std::cout << "wrote " << o.output << "\n";
   return 0;
 }

@@ -49,6 +49,7 @@ FH_LAYOUT(RenderParams, rr_depth, 108);
 FH_LAYOUT(RenderParams, light_count, 112);
 FH_LAYOUT(RenderParams, filter_table_size, 116);
 FH_LAYOUT(RenderParams, filter_radius, 120);
+FH_LAYOUT(RenderParams, replicates, 124);
 
 static_assert(sizeof(WavefrontCounters) == 108, "WavefrontCounters");
 FH_LAYOUT(WavefrontCounters, ray_length, 0);

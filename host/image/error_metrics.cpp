@@ -17,7 +17,7 @@ ImageError imageError(const Image& image, const Image& reference) {
   const size_t n = image.rgb.size();
   for (size_t i = 0; i < n; ++i) {
     const double d = double(image.rgb[i]) - double(reference.rgb[i]), r = reference.rgb[i];
-    e.relMse += d * d / (r * r + 0.01);
+    e.relMse += d * d / (r * r + kRelMseEpsilon);
     e.rmse += d * d;
     e.mae += std::fabs(d);
     e.meanImage[i % 3] += image.rgb[i];

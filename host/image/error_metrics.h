@@ -8,6 +8,9 @@
 
 namespace fh {
 
+// The epsilon of relMSE's denominator: keeps near-black pixels from dominating it.
+constexpr double kRelMseEpsilon = 0.01;
+
 struct ImageError {
   double relMse = 0.0, rmse = 0.0, mae = 0.0;
   // Per-channel means of both images: their ratio is the overall bias, which the

@@ -3,15 +3,17 @@
 
 #include <algorithm>
 
+#include "image/error_metrics.h"
+
 namespace fh {
 
 namespace {
 constexpr size_t kAovSums = 8;  // albedo rgb, normal xyz, depth, hits
 }
 
-Film::Film(int w, int h, bool surfaceAovs)
+Film::Film(int w, int h, bool surfaceAovs, bool twoReplicates)
     : width(w), height(h), sum(pixels() * 4, 0.0), sumSq(pixels() * 4, 0.0),
-      aovSum(surfaceAovs ? pixels() * kAovSums : 0, 0.0) {}
+      aovSum(surfaceAovs ? pixels() * kAovSums : 0, 0.0), oddSum(twoReplicates ? pixels() * 3 : 0, 0.0) {}
 
 void Film::addPass(const std::vector<float>& samples) {
   for (size_t i = 0; i < sum.size(); ++i) {
@@ -19,6 +21,10 @@ void Film::addPass(const std::vector<float>& samples) {
     sum[i] += v;
     if (i % 4 != 3) sumSq[i] += v * v;
   }
+  if (!oddSum.empty() && passes_ % 2 == 1)
+    for (size_t p = 0; p < pixels(); ++p)
+      for (size_t c = 0; c < 3; ++c) oddSum[3 * p + c] += samples[4 * p + c];
+  ++passes_;
   if (!hasSurfaceAovs()) return;
   const float* aovs = samples.data() + sum.size();
   for (size_t p = 0; p < pixels(); ++p) {
@@ -33,6 +39,29 @@ void Film::addPass(const std::vector<float>& samples) {
       out[7] += 1.0;
     }
   }
+}
+
+double Film::estimatedRelMse() const {
+  const bool replicated = !oddSum.empty() && passes_ >= 2;
+  // The mean of nEven and nOdd passes: its variance is D^2 nEven nOdd / n^2 in expectation,
+  // D the difference of the halves' means (each half's variance proportional to 1 / count).
+  const double nOdd = double(passes_ / 2), nEven = double(passes_) - nOdd;
+  double total = 0.0;
+  for (size_t p = 0; p < pixels(); ++p) {
+    const double n = count(p);
+    if (n <= 0) continue;
+    const std::array<double, 3> variance = varianceOfMean(p);
+    for (size_t c = 0; c < 3; ++c) {
+      const double mean = sum[4 * p + c] / n;
+      double error = variance[c];
+      if (replicated) {
+        const double odd = oddSum[3 * p + c], d = (sum[4 * p + c] - odd) / nEven - odd / nOdd;
+        error = d * d * nEven * nOdd / (n * n);
+      }
+      total += error / (mean * mean + kRelMseEpsilon);
+    }
+  }
+  return pixels() ? total / double(3 * pixels()) : 0.0;
 }
 
 std::vector<float> Film::albedo() const {

@@ -4,6 +4,7 @@
 #pragma once
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "image/image_io.h"
@@ -16,7 +17,9 @@ constexpr size_t kAovFloatsPerPixel = 8;
 
 struct Film {
   Film() = default;
-  Film(int w, int h, bool surfaceAovs = false);
+  // twoReplicates: even and odd passes come from independently scrambled sequences
+  // (RenderParams::replicates), which estimatedRelMse compares.
+  Film(int w, int h, bool surfaceAovs = false, bool twoReplicates = false);
 
   // Adds one pass: per pixel (rgb, 1), pixel-major, as the device's pass buffer holds it,
   // then, for a film with surface AOVs, kAovFloatsPerPixel per pixel.
@@ -25,6 +28,14 @@ struct Film {
   Image image() const;  // the mean per pixel
   // The variance of the pixel's mean estimate, per channel (sample variance / count).
   std::array<double, 3> varianceOfMean(size_t pixel) const;
+  // The image's expected relMSE against the converged image, estimated from the film alone:
+  // each pixel's expected squared error over its squared mean plus relMSE's epsilon,
+  // averaged like relMSE (image/error_metrics.h). The expected squared error of an unbiased
+  // mean is its variance: with two replicates, from the difference of the even and odd
+  // passes' means (unbiased, as the two are independent); else the sample variance / count,
+  // which overstates the error of low-discrepancy samples (they are not independent).
+  double estimatedRelMse() const;
+  uint64_t passes() const { return passes_; }
   double count(size_t pixel) const { return sum[4 * pixel + 3]; }
   size_t pixels() const { return size_t(width) * size_t(height); }
 
@@ -40,6 +51,11 @@ struct Film {
   std::vector<double> sum, sumSq;
   // Per pixel: albedo rgb, normal xyz, depth, samples that hit (sums in pass order).
   std::vector<double> aovSum;
+  // With two replicates: per pixel, the rgb sums of the odd passes.
+  std::vector<double> oddSum;
+
+ private:
+  uint64_t passes_ = 0;
 };
 
 // The depth of a pixel where nothing was hit (as Cycles writes its background's).

@@ -16,7 +16,7 @@ PassPool::PassPool(const RenderSettings& s, int workers)
       start_(std::chrono::steady_clock::now()),
       outstanding_(size_t(workers)),
       done_(size_t(workers), 0),
-      film_(s.width, s.height, s.surfaceAovs),
+      film_(s.width, s.height, s.surfaceAovs, s.noise > 0.0),
       progress_(s.progress),
       merger_([this] { mergeInOrder(); }) {}
 
@@ -51,6 +51,7 @@ bool PassPool::take(int worker, uint32_t& pass) {
       requeued_.pop_front();
       break;
     }
+    if (noiseReached_) return false;
     if (next_ < total_ && !outOfTime()) {
       pass = next_++;
       break;
@@ -90,8 +91,9 @@ uint64_t PassPool::passesDone(int worker) const {
 Film PassPool::finish(bool& complete) {
   stopMerging();
   std::lock_guard<std::mutex> lock(mutex_);
-  complete = pending_.empty() && requeued_.empty() && !anyOutstanding();
+  complete = noiseReached_ || (pending_.empty() && requeued_.empty() && !anyOutstanding());
   for (auto& [pass, samples] : pending_) {
+    if (noiseReached_) break;  // beyond the pass that met the target
     film_.addPass(samples);
     ++merged_;
   }
@@ -120,19 +122,30 @@ void PassPool::mergeInOrder() {
     pending_.erase(next);
     lock.unlock();
     film_.addPass(samples);
+    const bool check = settings_.noise > 0.0 && nextToMerge_ + 1 >= kNoiseMinPasses;
+    const double estimate = check ? film_.estimatedRelMse() : -1.0;
     lock.lock();
     spare_.push_back(std::move(samples));
     ++nextToMerge_;
     ++merged_;
+    if (check) noiseEstimate_ = estimate;
     showProgress();
+    if (check && estimate <= settings_.noise) {
+      noiseReached_ = true;  // no more passes start, and none after this one is merged
+      changed_.notify_all();
+      return;
+    }
   }
 }
 
 void PassPool::showProgress() {
   const double elapsed = secondsSince(start_);
-  const bool timed = settings_.seconds > 0.0;
-  progress_.update(merged_ * film_.pixels(), timed ? 0 : uint64_t(total_) * film_.pixels(), elapsed,
-                   timed ? std::min(1.0, elapsed / settings_.seconds) : 0.0);
+  const bool timed = settings_.seconds > 0.0, noisy = settings_.noise > 0.0;
+  // relMSE falls as 1 / samples, so target / estimate is the share of samples taken.
+  const double noiseShare = noiseEstimate_ > 0.0 ? std::min(1.0, settings_.noise / noiseEstimate_) : 0.0;
+  progress_.update(merged_ * film_.pixels(), timed || noisy ? 0 : uint64_t(total_) * film_.pixels(), elapsed,
+                   noisy ? std::min(1.0, std::max(noiseShare, timed ? elapsed / settings_.seconds : 0.0))
+                         : timed ? std::min(1.0, elapsed / settings_.seconds) : 0.0);
 }
 
 }  // namespace fh

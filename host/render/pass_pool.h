@@ -1,7 +1,11 @@
 // The passes of one render in one process: handed out to device workers until the sample
-// count or the time budget is reached, merged into the film in pass order by a thread of
-// its own (a worker hands a pass over and goes back to feeding its device), with one
-// progress display. One device is a pool with one worker.
+// count, the time budget or the noise target is reached, merged into the film in pass order
+// by a thread of its own (a worker hands a pass over and goes back to feeding its device),
+// with one progress display. One device is a pool with one worker.
+//
+// A noise target is checked on the film after each merged pass, so the render ends with the
+// first pass count whose film meets it: passes finished beyond it are dropped, and the image
+// for a seed and target is the same whichever devices rendered and however fast.
 #pragma once
 #include <chrono>
 #include <condition_variable>
@@ -57,6 +61,8 @@ class PassPool : public PassSource {
   Film film_;                                       // the merger's alone until finish()
   Progress progress_;
   bool stopping_ = false;
+  bool noiseReached_ = false;
+  double noiseEstimate_ = -1.0;  // the film's at the last check of a noise target
   std::thread merger_;
 };
 

@@ -24,10 +24,17 @@ const char* filterName(PixelFilter f);
 enum class Strategy { Auto, Scalar, Simd8, Megakernel, Megakernel8 };
 const char* strategyName(Strategy s);
 
+// Passes before a noise target is checked: fewer samples estimate a pixel's variance too
+// poorly (a light found once or not yet).
+constexpr unsigned kNoiseMinPasses = 16;
+
 struct RenderSettings {
   int width = 512, height = 512;
   int spp = 64;          // samples per pixel; with seconds > 0, the most to take
   double seconds = 0.0;  // time budget: stop at the end of the pass running when it is spent
+  // Noise target: stop once the film's estimated relMSE (Film::estimatedRelMse) is at most
+  // this, checked after each pass from kNoiseMinPasses on; 0: none.
+  double noise = 0.0;
   Method method = Method::MIS;
   int maxDepth = 64;     // bounces; Russian roulette does the real work
   // Russian roulette from this bounce on: later than the minimum because roulette adds

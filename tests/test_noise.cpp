@@ -1,0 +1,73 @@
+// --noise: a render stops once the film's estimated relMSE meets the target. The estimate
+// (Film::estimatedRelMse, from two independently scrambled replicates) is checked against
+// the truth, the relMSE against a long reference, on the Cornell box and the Veach plates:
+// within a factor 1.5 where the render stops. The reference's own error (its estimate)
+// is taken off the measured relMSE.
+#include <gtest/gtest.h>
+
+#include "image/error_metrics.h"
+#include "render/render.h"
+#include "scene/scene_loader.h"
+#include "test_support.h"
+
+namespace fh {
+namespace {
+
+Film renderFilm(const Scene& scene, int width, int height, int spp, double noise, unsigned seed) {
+  static DeviceContext dc(selectDevices(listDevices(), "").front());
+  const Bvh bvh = buildBvh(scene);
+  RenderSettings s = test::renderSettings();
+  s.width = width;
+  s.height = height;
+  s.spp = spp;
+  s.noise = noise;
+  s.seed = seed;
+  return fh::render(dc, scene, bvh, scene.camera, s).film;
+}
+
+// Renders to `target`, then checks the film's estimate against the error measured.
+void expectEstimateNearTheTruth(const Scene& scene, int width, int height, int referenceSpp, double target) {
+  // The reference with two replicates too (a target it never reaches), for its own error.
+  const Film reference = renderFilm(scene, width, height, referenceSpp, 1e-12, 1000);
+  for (unsigned seed : {1u, 2u}) {
+    const Film film = renderFilm(scene, width, height, referenceSpp, target, seed);
+    const double estimate = film.estimatedRelMse();
+    EXPECT_LE(estimate, target);
+    EXPECT_GE(film.passes(), uint64_t(kNoiseMinPasses));
+    EXPECT_LT(film.passes(), uint64_t(referenceSpp) / 8) << "the reference is too short for this target";
+    const double truth = imageError(film.image(), reference.image()).relMse - reference.estimatedRelMse();
+    EXPECT_GT(truth, estimate / 1.5) << "seed " << seed << ", " << film.passes() << " passes";
+    EXPECT_LT(truth, estimate * 1.5) << "seed " << seed << ", " << film.passes() << " passes";
+  }
+}
+
+TEST(NoiseTarget, EstimateMatchesTheTruthOnTheCornellBox) {
+  expectEstimateNearTheTruth(loadDefaultScene(), 32, 32, 4096, 3e-3);
+}
+
+// Near-mirror plates and small bright lights: heavy-tailed samples, the hard case for an
+// error estimate from the samples themselves.
+TEST(NoiseTarget, EstimateMatchesTheTruthOnTheVeachPlates) {
+  expectEstimateNearTheTruth(loadScene(test::testScene("veach/veach-plates.obj")), 48, 32, 16384, 1e-2);
+}
+
+// Stopping is decided on merged passes only, so the image for a seed and target is the
+// same whatever the wavefront size (which changes how many passes are in flight).
+TEST(NoiseTarget, TheStopIsDeterministic) {
+  static DeviceContext dc(selectDevices(listDevices(), "").front());
+  const Scene scene = loadDefaultScene();
+  const Bvh bvh = buildBvh(scene);
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = 24;
+  s.spp = 4096;
+  s.noise = 3e-3;
+  const RenderResult a = fh::render(dc, scene, bvh, scene.camera, s);
+  s.wavefront = 256;
+  const RenderResult b = fh::render(dc, scene, bvh, scene.camera, s);
+  EXPECT_EQ(a.film.passes(), b.film.passes());
+  EXPECT_EQ(a.film.sum, b.film.sum);
+  EXPECT_LT(a.film.passes(), 4096u);
+}
+
+}  // namespace
+}  // namespace fh
