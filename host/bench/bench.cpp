@@ -42,29 +42,36 @@ Camera benchCamera(const Scene& scene) {
   return frameBounds(lo, hi);
 }
 
-struct KernelTiming {
-  double wallSeconds = 0.0;    // median of enqueue to finish
-  double kernelSeconds = 0.0;  // median of the kernel's profiled execution
+// One launch: enqueue to finish on the host's clock, and the kernel's profiled time.
+struct LaunchTiming {
+  double wallSeconds = 0.0, kernelSeconds = 0.0;
 };
 
 template <typename Launch>
-KernelTiming timeKernel(DeviceContext& dc, int repeats, Launch launchOnce) {
-  std::vector<double> wall, kernel;
-  for (int r = -1; r < repeats; ++r) {  // r == -1 is the warm-up
-    cl::Event event;
-    const auto start = Clock::now();
-    launchOnce(&event);
-    FH_CL(dc.queue.finish());
-    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    if (r < 0) continue;
-    wall.push_back(seconds);
-    cl_ulong t0 = 0, t1 = 0;
-    FH_CL(event.getProfilingInfo(CL_PROFILING_COMMAND_START, &t0));
-    FH_CL(event.getProfilingInfo(CL_PROFILING_COMMAND_END, &t1));
-    kernel.push_back(double(t1 - t0) * 1e-9);
-  }
-  return {median(wall), median(kernel)};
+LaunchTiming timeLaunch(DeviceContext& dc, Launch launchOnce) {
+  cl::Event event;
+  const auto start = Clock::now();
+  launchOnce(&event);
+  FH_CL(dc.queue.finish());
+  LaunchTiming t;
+  t.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+  cl_ulong t0 = 0, t1 = 0;
+  FH_CL(event.getProfilingInfo(CL_PROFILING_COMMAND_START, &t0));
+  FH_CL(event.getProfilingInfo(CL_PROFILING_COMMAND_END, &t1));
+  t.kernelSeconds = double(t1 - t0) * 1e-9;
+  return t;
 }
+
+// A repeat of one ray kind takes at least this long per tracer (--repeats of them).
+constexpr double kRepeatSeconds = 0.05;
+
+// Each tracer's times, repeat by repeat, and fredholm's speed over the external tracer's
+// best within each repeat.
+struct KindTimings {
+  int passes = 1;  // traces of the rays per repeat and tracer
+  std::vector<double> wall, kernel, ratio;
+  std::vector<std::vector<double>> external;  // per external API
+};
 
 struct RayKind {
   std::string name;
@@ -106,32 +113,81 @@ class SceneBench {
   nlohmann::json timeKind(int deviceIndex, DeviceContext& dc, RayCaster& caster, RayWorkload& work, RayKind& kind) {
     const unsigned n = kind.rays.count;
     cl::Buffer out = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, n * 16ull, "bench hits");
-    const KernelTiming timing = timeKernel(dc, o_.repeats, [&](cl::Event* e) {
-      if (kind.occlusion) caster.intersectAny(kind.rays.org, kind.rays.dir, out, n, e);
-      else caster.intersectClosest(kind.rays.org, kind.rays.dir, out, n, e);
-    });
+    std::vector<int> theirs;
+    const KindTimings t = timeInterleaved(dc, caster, work, kind, out, theirs);
     nlohmann::json record = {{"scene", name_},
                              {"device", dc.info.name},
                              {"triangles", scene_.triangleCount()},
                              {"ray_kind", kind.name},
                              {"rays", n},
-                             {"mrays_per_s", n / timing.wallSeconds * 1e-6},
-                             {"kernel_mrays_per_s", n / timing.kernelSeconds * 1e-6}};
+                             {"mrays_per_s", n * t.passes / median(t.wall) * 1e-6},
+                             {"kernel_mrays_per_s", n * t.passes / median(t.kernel) * 1e-6}};
     std::cout << std::left << std::setw(12) << name_ << std::right << std::setw(4) << deviceIndex << std::setw(10)
               << scene_.triangleCount() << std::setw(9) << kind.name << std::setw(9) << n << std::fixed
-              << std::setprecision(2) << std::setw(10) << n / timing.wallSeconds * 1e-6 << std::setw(10)
-              << n / timing.kernelSeconds * 1e-6;
-    if (external_) compareWithExternal(dc, work, kind, out, record);
+              << std::setprecision(2) << std::setw(10) << n * t.passes / median(t.wall) * 1e-6 << std::setw(10)
+              << n * t.passes / median(t.kernel) * 1e-6;
+    if (external_) reportExternal(dc, work, kind, out, t, theirs, record);
     std::cout << std::defaultfloat << "\n";
     return record;
   }
 
-  // The external tracer on the same rays: its speed per API, and how often it finds the
-  // same triangle (or the same occlusion) as fredholm.
-  void compareWithExternal(DeviceContext& dc, RayWorkload& work, const RayKind& kind, const cl::Buffer& out,
-                           nlohmann::json& record) {
+  // fredholm and each external API in turn, repeat by repeat (who goes first alternates),
+  // so a noisy neighbour slows both alike and each repeat gives a ratio of its own.
+  KindTimings timeInterleaved(DeviceContext& dc, RayCaster& caster, RayWorkload& work, const RayKind& kind,
+                              const cl::Buffer& out, std::vector<int>& theirs) {
     const unsigned n = kind.rays.count;
-    const std::vector<float> org = work.readFloat4(kind.rays.org, n), dir = work.readFloat4(kind.rays.dir, n);
+    const std::vector<std::string> apis = external_ ? external_->apis() : std::vector<std::string>{};
+    std::vector<float> org, dir;
+    if (external_) {
+      org = work.readFloat4(kind.rays.org, n);
+      dir = work.readFloat4(kind.rays.dir, n);
+    }
+    KindTimings t;
+    t.external.resize(apis.size());
+    std::vector<double> seconds(apis.size());
+    // A repeat traces the rays `passes` times with each tracer: enough that the scheduler's
+    // hiccups (milliseconds) are small against it on scenes that trace in a few.
+    int passes = 1;
+    auto traceExternal = [&] {
+      for (size_t a = 0; a < apis.size(); ++a) {
+        seconds[a] = 0.0;
+        for (int i = 0; i < passes; ++i)
+          seconds[a] += external_->trace(apis[a], org, dir, kind.occlusion, kind.coherent, o_.threads, theirs);
+      }
+    };
+    auto traceOurs = [&] {
+      LaunchTiming sum;
+      for (int i = 0; i < passes; ++i) {
+        const LaunchTiming one = timeLaunch(dc, [&](cl::Event* e) {
+          if (kind.occlusion) caster.intersectAny(kind.rays.org, kind.rays.dir, out, n, e);
+          else caster.intersectClosest(kind.rays.org, kind.rays.dir, out, n, e);
+        });
+        sum.wallSeconds += one.wallSeconds;
+        sum.kernelSeconds += one.kernelSeconds;
+      }
+      return sum;
+    };
+    for (int r = -1; r < o_.repeats; ++r) {  // r == -1 is the warm-up
+      if (r % 2 != 0) traceExternal();
+      const LaunchTiming ours = traceOurs();
+      if (r % 2 == 0) traceExternal();
+      if (r < 0) {
+        passes = t.passes = std::max(1, int(std::ceil(kRepeatSeconds / ours.wallSeconds)));
+        continue;
+      }
+      t.wall.push_back(ours.wallSeconds);
+      t.kernel.push_back(ours.kernelSeconds);
+      for (size_t a = 0; a < apis.size(); ++a) t.external[a].push_back(seconds[a]);
+      if (!apis.empty()) t.ratio.push_back(*std::min_element(seconds.begin(), seconds.end()) / ours.wallSeconds);
+    }
+    return t;
+  }
+
+  // The external tracer's speed per API, the ratio (median over repeats, with its spread),
+  // and how often it finds the same triangle (or the same occlusion) as fredholm.
+  void reportExternal(DeviceContext& dc, RayWorkload& work, const RayKind& kind, const cl::Buffer& out,
+                      const KindTimings& t, const std::vector<int>& theirs, nlohmann::json& record) {
+    const unsigned n = kind.rays.count;
     // fredholm's answers, in file-order triangle ids, to check the tracers agree.
     std::vector<int> ours(n);
     if (kind.occlusion) {
@@ -139,31 +195,31 @@ class SceneBench {
     } else {
       const std::vector<float> hits = work.readFloat4(out, n);
       for (unsigned i = 0; i < n; ++i) {
-        int t;
-        std::memcpy(&t, &hits[4 * i + 3], 4);
-        ours[i] = t < 0 ? -1 : int(bvh_.order[size_t(t)]);
+        int tri;
+        std::memcpy(&tri, &hits[4 * i + 3], 4);
+        ours[i] = tri < 0 ? -1 : int(bvh_.order[size_t(tri)]);
       }
     }
     double best = 0.0;
-    std::vector<int> theirs;
-    for (const std::string& api : external_->apis()) {
-      std::vector<double> seconds;
-      for (int r = -1; r < o_.repeats; ++r) {
-        const double s = external_->trace(api, org, dir, kind.occlusion, kind.coherent, o_.threads, theirs);
-        if (r >= 0) seconds.push_back(s);
-      }
-      const double mrays = n / median(seconds) * 1e-6;
-      record["embree_" + api + "_mrays_per_s"] = mrays;
+    const std::vector<std::string> apis = external_->apis();
+    for (size_t a = 0; a < apis.size(); ++a) {
+      const double mrays = n * t.passes / median(t.external[a]) * 1e-6;
+      record["embree_" + apis[a] + "_mrays_per_s"] = mrays;
       best = std::max(best, mrays);
       std::cout << std::setw(10) << mrays;
     }
     size_t agree = 0;
     for (unsigned i = 0; i < n; ++i) agree += ours[i] == theirs[i];
+    const auto [low, high] = std::minmax_element(t.ratio.begin(), t.ratio.end());
     record["embree_mrays_per_s"] = best;
-    record["ratio_to_embree"] = record["mrays_per_s"].get<double>() / best;
+    record["ratio_to_embree"] = median(t.ratio);
+    record["ratio_to_embree_min"] = *low;
+    record["ratio_to_embree_max"] = *high;
     record["agreement_with_embree"] = double(agree) / n;
-    std::cout << std::setw(8) << record["ratio_to_embree"].get<double>() << std::setw(7) << std::setprecision(1)
-              << 100.0 * agree / n << "%";
+    std::ostringstream spread;
+    spread << std::fixed << std::setprecision(2) << *low << "-" << *high;
+    std::cout << std::setw(8) << median(t.ratio) << std::setw(11) << spread.str() << std::setw(7)
+              << std::setprecision(1) << 100.0 * agree / n << "%";
   }
 
   const BenchOptions& o_;
@@ -181,7 +237,7 @@ void printHeader(const std::vector<DeviceInfo>& devices, const ExternalTracer* e
             << "triangles" << std::setw(9) << "kind" << std::setw(9) << "rays" << std::setw(10) << "Mrays/s"
             << std::setw(10) << "kernel";
   if (external) std::cout << std::setw(10) << "E single" << std::setw(10) << "E stream" << std::setw(8) << "ratio"
-                          << std::setw(8) << "agree";
+                          << std::setw(11) << "spread" << std::setw(8) << "agree";
   std::cout << "\n";
 }
 
