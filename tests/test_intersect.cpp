@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <future>
 #include <random>
 
@@ -341,6 +342,28 @@ std::string placementName(const Placement& p) {
   std::ostringstream s;
   s << "scale " << p.scale << " offset (" << p.offset[0] << "," << p.offset[1] << "," << p.offset[2] << ")";
   return s.str();
+}
+
+// The parallel build forks subtrees onto threads and grafts them where a serial build puts
+// them: the same tree, bit for bit, for any thread count (so images do not depend on the
+// machine's cores), and the SAH cost it reports is that tree's.
+TEST(BvhBuild, TheSameTreeOnAnyNumberOfThreads) {
+  const Scene scene = loadScene(test::testScene("blob/CornellBox-Blob.obj"));
+  const Bvh serial = buildBvh(scene, 1);
+  for (unsigned threads : {2u, 3u, 8u}) {
+    const Bvh parallel = buildBvh(scene, threads);
+    EXPECT_EQ(parallel.order, serial.order) << threads;
+    ASSERT_EQ(parallel.nodes.size(), serial.nodes.size()) << threads;
+    ASSERT_EQ(parallel.blocks.size(), serial.blocks.size()) << threads;
+    EXPECT_EQ(std::memcmp(parallel.nodes.data(), serial.nodes.data(), serial.nodes.size() * sizeof(gpu::Bvh8Node)), 0);
+    EXPECT_EQ(std::memcmp(parallel.blocks.data(), serial.blocks.data(),
+                          serial.blocks.size() * sizeof(gpu::TriangleBlock8)), 0);
+    EXPECT_EQ(parallel.stats.sahCost, serial.stats.sahCost);
+  }
+  // A tree's SAH cost is at least a root visit plus testing a ray's share of every triangle
+  // once, and below testing them all.
+  EXPECT_GT(serial.stats.sahCost, 1.0);
+  EXPECT_LT(serial.stats.sahCost, 0.15 * double(scene.triangleCount()));
 }
 
 TEST(Watertight, RaysAtSharedEdgesAndVerticesNeverMiss) {

@@ -1,10 +1,14 @@
-// Binned SAH build (32 bins, all three axes) and the collapse into 8-wide nodes.
+// Binned SAH build (32 bins, all three axes), with subtrees built in parallel, and the
+// collapse into 8-wide nodes.
 #include "accel/bvh.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <future>
+#include <thread>
 
 #include "base/vec.h"
 
@@ -18,16 +22,19 @@ constexpr unsigned kMaxLeaf = FH_MAX_LEAF_TRIANGLES;
 constexpr float kTraversalCost = 1.0f;
 constexpr float kTriangleCost = 0.15f;
 
+// Grown with plain comparisons (std::min/max), which compile inline: fminf/fmaxf, which
+// must handle NaNs (scenes have none: the loader rejects them), were library calls on
+// the build's hot path.
 struct Box {
   float3 lo{INFINITY, INFINITY, INFINITY};
   float3 hi{-INFINITY, -INFINITY, -INFINITY};
-  void grow(const float3& p) {
-    lo = minv(lo, p);
-    hi = maxv(hi, p);
-  }
-  void grow(const Box& b) {
-    lo = minv(lo, b.lo);
-    hi = maxv(hi, b.hi);
+  void grow(const float3& p) { grow(p, p); }
+  void grow(const Box& b) { grow(b.lo, b.hi); }
+  void grow(const float3& low, const float3& high) {
+    for (size_t k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], low[k]);
+      hi[k] = std::max(hi[k], high[k]);
+    }
   }
   float area() const {
     if (lo[0] > hi[0]) return 0.f;
@@ -42,25 +49,53 @@ struct BinaryNode {
   unsigned first = 0, count = 0;
 };
 
+// The triangles a build partitions: boxes and centroids by file-order id, and the ids in
+// the order the build arranges them (each subtree owns a contiguous range).
+struct Primitives {
+  std::vector<Box> boxes;
+  std::vector<float3> centroids;
+  std::vector<unsigned> index;
+};
+
+// Boxes and centroids of every triangle, on `threads` threads.
+Primitives gatherPrimitives(const Scene& scene, unsigned threads) {
+  Primitives p;
+  const size_t n = scene.triangleCount();
+  p.boxes.resize(n);
+  p.centroids.resize(n);
+  p.index.resize(n);
+  auto range = [&](size_t begin, size_t end) {
+    for (size_t t = begin; t < end; ++t) {
+      for (int k = 0; k < 3; ++k) p.boxes[t].grow(scene.corner(t, k));
+      p.centroids[t] = (p.boxes[t].lo + p.boxes[t].hi) * 0.5f;
+      p.index[t] = unsigned(t);
+    }
+  };
+  std::vector<std::thread> workers;
+  for (unsigned w = 1; w < threads; ++w) workers.emplace_back(range, n * w / threads, n * (w + 1) / threads);
+  range(0, n / threads);
+  for (auto& w : workers) w.join();
+  return p;
+}
+
+// Subtrees at least this large build their second child on a thread of its own (while the
+// tree is shallower than parallelDepth): smaller ones cost less than starting a thread.
+constexpr unsigned kParallelTriangles = 16384;
+
+// A binary subtree over primitives' index range, root at node 0, children depth first
+// (left subtree, then right). Large right subtrees are built concurrently by builders of
+// their own and grafted in at the index a serial build gives them, so the tree is the same
+// whatever the thread count.
 class BinaryBuilder {
  public:
-  BinaryBuilder(const Scene& scene) : boxes_(scene.triangleCount()), centroids_(scene.triangleCount()) {
-    for (size_t t = 0; t < scene.triangleCount(); ++t) {
-      for (int k = 0; k < 3; ++k) boxes_[t].grow(scene.corner(t, k));
-      centroids_[t] = (boxes_[t].lo + boxes_[t].hi) * 0.5f;
-    }
-    index_.resize(scene.triangleCount());
-    for (size_t i = 0; i < index_.size(); ++i) index_[i] = unsigned(i);
-  }
+  BinaryBuilder(Primitives& primitives, int parallelDepth) : p_(primitives), parallelDepth_(parallelDepth) {}
 
-  std::vector<BinaryNode> build() {
-    nodes_.reserve(2 * index_.size());
+  std::vector<BinaryNode> build(unsigned first, unsigned count, int depth = 0) {
+    nodes_.reserve(2 * size_t(count));
     nodes_.emplace_back();
-    split(0, 0, unsigned(index_.size()));
+    split(0, first, count, depth);
     return std::move(nodes_);
   }
-
-  const std::vector<unsigned>& order() const { return index_; }
 
  private:
   struct Split {
@@ -78,9 +113,9 @@ class BinaryBuilder {
       unsigned counts[kBins] = {};
       const float scale = kBins / extent;
       for (unsigned i = first; i < first + count; ++i) {
-        const unsigned t = index_[i];
-        const int b = std::min(kBins - 1, int((centroids_[t][size_t(axis)] - lo) * scale));
-        bins[b].grow(boxes_[t]);
+        const unsigned t = p_.index[i];
+        const int b = std::min(kBins - 1, int((p_.centroids[t][size_t(axis)] - lo) * scale));
+        bins[b].grow(p_.boxes[t]);
         ++counts[b];
       }
       // Sweep from the right to get the right-side areas, then from the left.
@@ -113,11 +148,11 @@ class BinaryBuilder {
     nodes_[size_t(node)].count = count;
   }
 
-  void split(int node, unsigned first, unsigned count) {
+  void split(int node, unsigned first, unsigned count, int depth) {
     Box box, centroidBox;
     for (unsigned i = first; i < first + count; ++i) {
-      box.grow(boxes_[index_[i]]);
-      centroidBox.grow(centroids_[index_[i]]);
+      box.grow(p_.boxes[p_.index[i]]);
+      centroidBox.grow(p_.centroids[p_.index[i]]);
     }
     nodes_[size_t(node)].box = box;
     if (count == 1) return makeLeaf(node, first, count);
@@ -127,10 +162,10 @@ class BinaryBuilder {
     unsigned mid = first;
     if (s.axis >= 0) {
       if (count <= kMaxLeaf && kTriangleCost * float(count) <= s.cost) return makeLeaf(node, first, count);
-      auto* begin = index_.data() + first;
+      auto* begin = p_.index.data() + first;
       mid = unsigned(std::partition(begin, begin + count,
-                                    [&](unsigned t) { return centroids_[t][size_t(s.axis)] < s.position; }) -
-                     index_.data());
+                                    [&](unsigned t) { return p_.centroids[t][size_t(s.axis)] < s.position; }) -
+                     p_.index.data());
     }
     if (mid == first || mid == first + count) {
       // All centroids coincide (or binning could not separate them).
@@ -142,15 +177,48 @@ class BinaryBuilder {
     nodes_.emplace_back();
     nodes_[size_t(node)].left = left;
     nodes_[size_t(node)].right = left + 1;
-    split(left, first, mid - first);
-    split(left + 1, mid, first + count - mid);
+    const unsigned rightCount = first + count - mid;
+    if (depth < parallelDepth_ && rightCount >= kParallelTriangles) {
+      // The two children own disjoint ranges of the index: the right one on another thread.
+      auto right = std::async(std::launch::async, [this, mid, rightCount, depth] {
+        return BinaryBuilder(p_, parallelDepth_).build(mid, rightCount, depth + 1);
+      });
+      split(left, first, mid - first, depth + 1);
+      graft(left + 1, right.get());
+    } else {
+      split(left, first, mid - first, depth + 1);
+      split(left + 1, mid, rightCount, depth + 1);
+    }
   }
 
-  std::vector<Box> boxes_;
-  std::vector<float3> centroids_;
-  std::vector<unsigned> index_;
+  // Puts a subtree built on its own at `node` (its root) and after the nodes so far (its
+  // other nodes), where a serial build numbers them.
+  void graft(int node, std::vector<BinaryNode> subtree) {
+    const int base = int(nodes_.size()) - 1;  // subtree node i > 0 goes to base + i
+    for (BinaryNode& n : subtree)
+      if (n.count == 0) {
+        n.left += base;
+        n.right += base;
+      }
+    nodes_[size_t(node)] = subtree[0];
+    nodes_.insert(nodes_.end(), subtree.begin() + 1, subtree.end());
+  }
+
+  Primitives& p_;
+  int parallelDepth_;
   std::vector<BinaryNode> nodes_;
 };
+
+// The surface area heuristic's cost of a binary tree (kTraversalCost per node visited,
+// kTriangleCost per triangle tested, each weighted by its box's area over the root's): the
+// build's quality, comparable between builders.
+double sahCost(const std::vector<BinaryNode>& nodes) {
+  const double root = std::max(double(nodes[0].box.area()), 1e-30);
+  double cost = 0.0;
+  for (const BinaryNode& n : nodes)
+    cost += double(n.box.area()) / root * (n.count == 0 ? kTraversalCost : kTriangleCost * double(n.count));
+  return cost;
+}
 
 class WideCollapser {
  public:
@@ -244,13 +312,22 @@ class WideCollapser {
 
 }  // namespace
 
-Bvh buildBvh(const Scene& scene) {
+Bvh buildBvh(const Scene& scene, unsigned threads) {
   const auto start = std::chrono::steady_clock::now();
+  // FREDHOLM_BVH_THREADS caps the default (bench/RESULTS.md compares thread counts).
+  const char* cap = std::getenv("FREDHOLM_BVH_THREADS");
+  if (threads == 0 && cap && *cap) threads = unsigned(std::max(1, std::atoi(cap)));
+  if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   Bvh bvh;
-  BinaryBuilder builder(scene);
-  const std::vector<BinaryNode> binary = builder.build();
-  bvh.order = builder.order();
+  Primitives primitives = gatherPrimitives(scene, threads);
+  // Levels that fork: enough subtrees for every thread, and some over for uneven splits.
+  int parallelDepth = 0;
+  while (threads > 1 && (1u << parallelDepth) < 4 * threads) ++parallelDepth;
+  const std::vector<BinaryNode> binary =
+      BinaryBuilder(primitives, parallelDepth).build(0, unsigned(primitives.index.size()));
+  bvh.order = std::move(primitives.index);
   bvh.stats.binaryNodes = binary.size();
+  bvh.stats.sahCost = sahCost(binary);
 
   WideCollapser(binary, scene, bvh.order, bvh).collapseRoot();
   bvh.stats.wideNodes = bvh.nodes.size();

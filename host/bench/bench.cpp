@@ -242,13 +242,15 @@ void printHeader(const std::vector<DeviceInfo>& devices, const ExternalTracer* e
 }
 
 nlohmann::json sceneSummary(const std::string& name, const Scene& scene, const Bvh& bvh) {
-  std::cout << "  " << name << ": BVH " << std::fixed << std::setprecision(3) << bvh.stats.buildSeconds << " s, "
-            << std::setprecision(1) << bvh.bytes() / double(1 << 20) << " MiB ("
+  std::cout << "  " << name << ": BVH " << std::fixed << std::setprecision(3) << bvh.stats.buildSeconds << " s, SAH "
+            << std::setprecision(2) << bvh.stats.sahCost << ", " << std::setprecision(1)
+            << bvh.bytes() / double(1 << 20) << " MiB ("
             << double(bvh.bytes()) / double(scene.triangleCount()) << " B/triangle), depth " << bvh.stats.depth
             << std::defaultfloat << "\n";
   return {{"scene", name},
           {"triangles", scene.triangleCount()},
           {"bvh_build_seconds", bvh.stats.buildSeconds},
+          {"bvh_sah_cost", bvh.stats.sahCost},
           {"bvh_bytes", bvh.bytes()},
           {"bvh_bytes_per_triangle", double(bvh.bytes()) / double(scene.triangleCount())},
           {"bvh_wide_nodes", bvh.stats.wideNodes},
