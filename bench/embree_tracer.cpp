@@ -5,6 +5,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -20,6 +21,7 @@ class EmbreeTracer : public ExternalTracer {
  public:
   EmbreeTracer() : device_(rtcNewDevice("threads=2")) {
     if (!device_) throw std::runtime_error("Embree: rtcNewDevice failed");
+    rtcSetDeviceMemoryMonitorFunction(device_, &EmbreeTracer::countBytes, this);
   }
   ~EmbreeTracer() override {
     if (scene_) rtcReleaseScene(scene_);
@@ -34,6 +36,7 @@ class EmbreeTracer : public ExternalTracer {
   double build(const Scene& scene) override {
     const auto start = std::chrono::steady_clock::now();
     if (scene_) rtcReleaseScene(scene_);
+    const long long before = allocated_.load();
     scene_ = rtcNewScene(device_);
     rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
     RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -49,8 +52,11 @@ class EmbreeTracer : public ExternalTracer {
     rtcAttachGeometry(scene_, geometry);
     rtcReleaseGeometry(geometry);
     rtcCommitScene(scene_);
+    sceneBytes_ = size_t(std::max(0LL, allocated_.load() - before));
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
+
+  size_t sceneBytes() const override { return sceneBytes_; }
 
   double trace(const std::string& api, const std::vector<float>& org, const std::vector<float>& dir, bool occlusion,
                bool coherent, int threads, std::vector<int>& triangle) override {
@@ -109,8 +115,16 @@ class EmbreeTracer : public ExternalTracer {
   }
 
  private:
+  // Embree reports every allocation and release: the scene's share is what a build adds.
+  static bool countBytes(void* self, ssize_t bytes, bool /*post*/) {
+    static_cast<EmbreeTracer*>(self)->allocated_ += bytes;
+    return true;
+  }
+
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
+  std::atomic<long long> allocated_{0};
+  size_t sceneBytes_ = 0;
 };
 
 }  // namespace

@@ -283,7 +283,11 @@ int runBench(const BenchOptions& o) {
     addBenchLightIfNone(scene);
     const Bvh bvh = buildBvh(scene);
     nlohmann::json info = sceneSummary(name, scene, bvh);
-    if (external) info["embree_build_seconds"] = external->build(scene);
+    if (external) {
+      info["embree_build_seconds"] = external->build(scene);
+      info["embree_bytes"] = external->sceneBytes();
+      info["embree_bytes_per_triangle"] = double(external->sceneBytes()) / double(scene.triangleCount());
+    }
     info["per_device"] = nlohmann::json::array();
     SceneBench bench(o, external.get(), name, scene, bvh);
     for (size_t i = 0; i < contexts.size(); ++i) info["per_device"].push_back(bench.run(int(i), *contexts[i], records));

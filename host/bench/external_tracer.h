@@ -15,6 +15,8 @@ class ExternalTracer {
   virtual std::string name() const = 0;
   // Builds the tracer's own acceleration structure; returns seconds.
   virtual double build(const Scene& scene) = 0;
+  // Memory the last build holds (its copy of the geometry and its BVH), in bytes.
+  virtual size_t sceneBytes() const = 0;
   // The APIs it offers ("single", "stream", ...).
   virtual std::vector<std::string> apis() const = 0;
   // Traces rays (float4 origin.xyz+tmin, float4 direction.xyz+tmax) with `threads`

@@ -78,7 +78,8 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
 CLI::App* addBench(CLI::App& app, BenchOptions& o) {
   CLI::App* benching = app.add_subcommand("bench", "Measure ray-casting throughput (Mrays/s) per scene and ray kind");
   benching->add_option("scenes", o.scenes,
-                       "Scenes: cornell, bunny-box, sponza, bunnies-1m, or OBJ files (default: all four)");
+                       "Scenes: cornell, bunny-box, sponza, bunnies-1m, spheres:N (about N generated triangles, e.g. "
+                       "spheres:1e6), or OBJ files (default: the first four)");
   benching->add_option("--device", o.device,
                        std::string("Devices to measure, a row each: ") + kDeviceSpec);
   benching->add_option("--json", o.jsonPath, "Write the results as JSON");
