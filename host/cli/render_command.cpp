@@ -1,5 +1,6 @@
 // `fredholm render`: flags checked before any work, then scene, camera, BVH, one render on
 // every device --device selects, and the image with its metadata.
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -177,7 +178,9 @@ int runRender(RenderOptions o) {
   // An explicit -o is never overwritten without --force; the default name steps aside.
   if (o.output.empty()) o.output = firstFreeName(layers.empty() ? "fredholm.png" : "fredholm.exr");
   checkOutputPath(o.output, o.force);
-  if (!layers.empty() && std::filesystem::path(o.output).extension() != ".exr")
+  std::string extension = std::filesystem::path(o.output).extension().string();
+  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (!layers.empty() && extension != ".exr")
     throw Error("--aovs: layers are written into one EXR; -o '" + o.output + "' is not an .exr file");
   if (!o.statsFile.empty()) checkOutputFile(o.statsFile, o.force, "--stats");
   const auto devices = selectDevices(listDevices(), o.device);
