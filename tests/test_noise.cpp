@@ -4,6 +4,10 @@
 // within a factor 1.5 where the render stops. The reference's own error (its estimate)
 // is taken off the measured relMSE.
 #include <gtest/gtest.h>
+#include <OpenImageIO/imageio.h>
+
+#include <filesystem>
+#include <string>
 
 #include "image/error_metrics.h"
 #include "render/render.h"
@@ -67,6 +71,26 @@ TEST(NoiseTarget, TheStopIsDeterministic) {
   EXPECT_EQ(a.film.passes(), b.film.passes());
   EXPECT_EQ(a.film.sum, b.film.sum);
   EXPECT_LT(a.film.passes(), 4096u);
+}
+
+// The command line: the render says it met the target and the file carries the estimate;
+// a negative or non-numeric target is a one-line error before any work.
+TEST(NoiseCli, MeetsTheTargetAndWritesTheEstimate) {
+  const std::string dir = test::tempDir("noise-cli");
+  const auto r = test::runFredholm("render --width 24 --height 24 --noise 3e-3 -o " + dir + "/n.exr");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("meets --noise 3.000e-03"), std::string::npos) << r.output;
+  auto in = OIIO::ImageInput::open(dir + "/n.exr");
+  ASSERT_TRUE(in);
+  const double estimate = std::stod(in->spec().get_string_attribute("fredholm:estimated_relmse"));
+  EXPECT_GT(estimate, 0.0);
+  EXPECT_LE(estimate, 3e-3);
+  for (const char* bad : {"-1", "abc"}) {
+    const auto e = test::runFredholm(std::string("render --noise ") + bad + " -o " + dir + "/bad.exr");
+    EXPECT_NE(e.exitCode, 0) << bad;
+    EXPECT_NE(e.output.find("--noise"), std::string::npos) << e.output;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/bad.exr"));
+  }
 }
 
 }  // namespace

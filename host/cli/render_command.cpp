@@ -165,15 +165,11 @@ void reportDevices(const RenderResult& r) {
     std::cerr << "fredholm: warning: " << r.stats.nonfinite << " samples were NaN or infinite and dropped\n";
 }
 
-}  // namespace
-
-int runRender(RenderOptions o) {
-  RenderSettings settings = settingsFrom(o);
-  settings.stop = &installInterruptHandlers();
-  const bool debugView = !o.aov.empty();
-  const Aov aov = debugView ? parseAov(o.aov) : Aov::Albedo;
+// The --aovs layers, parsed and checked against the other flags and the output; picks the
+// default output name (PNG, or EXR with layers) and checks every output file before work.
+std::vector<std::string> checkOutputs(RenderOptions& o, RenderSettings& settings) {
   const std::vector<std::string> layers = o.aovs.empty() ? std::vector<std::string>{} : parseAovLayers(o.aovs);
-  if (debugView && !layers.empty()) throw Error("--aov (a debug view) and --aovs (layers beside the image): pick one");
+  if (!o.aov.empty() && !layers.empty()) throw Error("--aov (a debug view) and --aovs (layers beside the image): pick one");
   for (const auto& layer : layers) settings.surfaceAovs |= isSurfaceAov(layer);
   // An explicit -o is never overwritten without --force; the default name steps aside.
   if (o.output.empty()) o.output = firstFreeName(layers.empty() ? "fredholm.png" : "fredholm.exr");
@@ -183,8 +179,45 @@ int runRender(RenderOptions o) {
   if (!layers.empty() && extension != ".exr")
     throw Error("--aovs: layers are written into one EXR; -o '" + o.output + "' is not an .exr file");
   if (!o.statsFile.empty()) checkOutputFile(o.statsFile, o.force, "--stats");
+  return layers;
+}
+
+// The render's facts in the image file's metadata.
+std::map<std::string, std::string> imageMetadata(const RenderOptions& o, const Scene& scene, const RenderResult& r,
+                                                 const std::string& method, double spp, double seconds) {
+  std::map<std::string, std::string> metadata = {
+      {"scene", scene.sourcePath},       {"spp", formatSeconds(spp)},          {"method", method},
+      {"device", r.stats.contributors()}, {"seed", std::to_string(o.seed)},     {"seconds", formatSeconds(seconds)},
+      {"filter", o.filter},              {"max_depth", std::to_string(o.maxDepth)}};
+  if (!o.aovs.empty()) metadata["aovs"] = o.aovs;
+  if (o.aov.empty()) metadata["estimated_relmse"] = formatScientific(r.film.estimatedRelMse());
+  return metadata;
+}
+
+void printSummary(const RenderOptions& o, const RenderSettings& settings, const Scene& scene, const RenderResult& r,
+                  const std::string& method, double spp, double seconds) {
+  std::cerr << "fredholm: rendered " << scene.sourcePath << " (" << scene.triangleCount() << " triangles, "
+            << scene.lights.size() << " emissive; " << (o.allFeatures ? "all features" : sceneFeatures(scene).describe())
+            << ") with " << method << ", " << o.width << "x" << o.height << ", " << spp << " spp on "
+            << r.stats.contributors() << " in " << formatSeconds(seconds) << " s\n";
+  if (settings.noise > 0) {
+    const double noise = r.film.estimatedRelMse();
+    const bool met = noise <= settings.noise;
+    std::cerr << "fredholm: estimated relMSE " << formatScientific(noise) << (met ? " meets" : " has not reached")
+              << " --noise " << formatScientific(settings.noise) << (met ? "" : " (stopped by --spp or --time)") << "\n";
+  }
+}
+
+}  // namespace
+
+int runRender(RenderOptions o) {
+  RenderSettings settings = settingsFrom(o);
+  settings.stop = &installInterruptHandlers();
+  const bool debugView = !o.aov.empty();
+  const Aov aov = debugView ? parseAov(o.aov) : Aov::Albedo;
+  const std::vector<std::string> layers = checkOutputs(o, settings);
   const auto devices = selectDevices(listDevices(), o.device);
-  if (!o.aov.empty() && devices.size() > 1)
+  if (debugView && devices.size() > 1)
     throw Error("--aov renders on one device, and --device '" + o.device + "' selects " +
                 std::to_string(devices.size()) + "; pick one (e.g. --device " + std::to_string(devices[0].index) +
                 ")");
@@ -204,14 +237,7 @@ int runRender(RenderOptions o) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // The film's samples per pixel: a noise target drops the passes finished past it.
   const double spp = debugView ? double(r.stats.samples) / double(r.film.pixels()) : r.film.count(0);
-  const double noise = debugView ? 0.0 : r.film.estimatedRelMse();
-  const std::string devicesUsed = r.stats.contributors();
-  std::map<std::string, std::string> metadata = {{"scene", scene.sourcePath}, {"spp", formatSeconds(spp)}, {"method", method},
-                            {"device", devicesUsed}, {"seed", std::to_string(o.seed)},
-                            {"seconds", formatSeconds(seconds)}, {"filter", o.filter},
-                            {"max_depth", std::to_string(o.maxDepth)}};
-  if (!layers.empty()) metadata["aovs"] = o.aovs;
-  if (!debugView) metadata["estimated_relmse"] = formatScientific(noise);
+  std::map<std::string, std::string> metadata = imageMetadata(o, scene, r, method, spp, seconds);
   const Image image = imageWithLayers(r.film, layers);
   const std::string passes = std::to_string(r.stats.samples / r.film.pixels()) + " passes";
   if (r.stopped) {
@@ -228,14 +254,7 @@ int runRender(RenderOptions o) {
                 " finished so far to " + o.output);
   }
   writeImage(o.output, image, metadata);
-  std::cerr << "fredholm: rendered " << scene.sourcePath << " (" << scene.triangleCount() << " triangles, "
-            << scene.lights.size() << " emissive; " << (o.allFeatures ? "all features" : sceneFeatures(scene).describe())
-            << ") with " << method << ", " << o.width << "x" << o.height << ", " << spp << " spp on " << devicesUsed
-            << " in " << formatSeconds(seconds) << " s\n";
-  if (settings.noise > 0)
-    std::cerr << "fredholm: estimated relMSE " << formatScientific(noise)
-              << (noise <= settings.noise ? " meets" : " has not reached") << " --noise " << formatScientific(settings.noise)
-              << (noise <= settings.noise ? "" : " (stopped by --spp or --time)") << "\n";
+  printSummary(o, settings, scene, r, method, spp, seconds);
   std::cout << "wrote " << o.output << "\n";
   return 0;
 }
