@@ -28,6 +28,8 @@ struct RenderOptions {
   std::optional<float> fov;
   std::string aov;
   std::string aovs;  // --aovs: layers written beside the image in one EXR
+  std::string checkpoint, resume;  // --checkpoint FILE, --resume FILE
+  double checkpointEvery = RenderSettings{}.checkpointSeconds;
   std::string device;
 };
 int runRender(RenderOptions o);

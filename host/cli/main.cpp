@@ -70,6 +70,13 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
                         "Layers written beside the image in one EXR, from the same render: albedo, normal "
                         "(first non-specular surface), depth (camera ray), variance (of each pixel's mean), "
                         "spp; e.g. albedo,normal,depth");
+  rendering->add_option("--checkpoint", o.checkpoint,
+                        "Save the render so far to FILE every --checkpoint-every seconds and when it ends "
+                        "(also on Ctrl-C), to go on from with --resume");
+  rendering->add_option("--checkpoint-every", o.checkpointEvery, "Seconds between checkpoints")->capture_default_str();
+  rendering->add_option("--resume", o.resume,
+                        "Go on from a checkpoint of the same scene and settings (--spp may be raised): the image "
+                        "is the one an uninterrupted render gives");
   rendering->add_option("--device", o.device,
                         std::string("Devices sharing the render (--aov: one): ") + kDeviceSpec);
   return rendering;

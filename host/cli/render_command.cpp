@@ -8,6 +8,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <sstream>
 
 #include "base/atomic_file.h"
@@ -17,6 +18,7 @@
 #include "cli/interrupt.h"
 #include "device/devices.h"
 #include "image/image_io.h"
+#include "render/checkpoint.h"
 #include "render/render.h"
 #include "render/render_aov.h"
 #include "render/wavefront.h"
@@ -179,6 +181,12 @@ std::vector<std::string> checkOutputs(RenderOptions& o, RenderSettings& settings
   if (!layers.empty() && extension != ".exr")
     throw Error("--aovs: layers are written into one EXR; -o '" + o.output + "' is not an .exr file");
   if (!o.statsFile.empty()) checkOutputFile(o.statsFile, o.force, "--stats");
+  // The checkpoint a render resumes from is its own to overwrite.
+  if (!o.checkpoint.empty() && o.checkpoint != o.resume) checkOutputFile(o.checkpoint, o.force, "--checkpoint");
+  if (!std::isfinite(o.checkpointEvery) || o.checkpointEvery < 0)
+    throw Error("--checkpoint-every must be a finite number of seconds, 0 or more");
+  settings.checkpointPath = o.checkpoint;
+  settings.checkpointSeconds = o.checkpointEvery;
   return layers;
 }
 
@@ -225,6 +233,11 @@ int runRender(RenderOptions o) {
   const Scene scene = loadSceneSpec(o.scene);
   printWarnings(scene);
   const Camera camera = chooseCamera(o, scene);
+  settings.fingerprint = renderFingerprint(scene, camera, settings);
+  if (!o.resume.empty()) {
+    if (debugView) throw Error("--resume goes on with a render's passes; --aov renders none");
+    settings.resume = std::make_shared<Film>(loadCheckpoint(o.resume, settings.fingerprint, "--resume"));
+  }
   const auto start = std::chrono::steady_clock::now();
   const Bvh bvh = buildBvh(scene);
   const RenderResult r = debugView ? renderDebugView(aov, devices, scene, bvh, camera, settings)
@@ -239,13 +252,16 @@ int runRender(RenderOptions o) {
   const double spp = debugView ? double(r.stats.samples) / double(r.film.pixels()) : r.film.count(0);
   std::map<std::string, std::string> metadata = imageMetadata(o, scene, r, method, spp, seconds);
   const Image image = imageWithLayers(r.film, layers);
-  const std::string passes = std::to_string(r.stats.samples / r.film.pixels()) + " passes";
+  const std::string passes = std::to_string(uint64_t(r.film.count(0))) + " passes";
   if (r.stopped) {
     const int signal = settings.stop->load();
-    if (r.stats.samples == 0) throw Interrupted("before any pass was finished; nothing written", signal);
+    if (r.film.count(0) == 0) throw Interrupted("before any pass was finished; nothing written", signal);
     metadata["incomplete"] = "interrupted by signal " + std::to_string(signal);
     writeImage(o.output, image, metadata);
-    throw Interrupted("wrote the " + passes + " finished so far to " + o.output, signal);
+    throw Interrupted("wrote the " + passes + " finished so far to " + o.output +
+                          (o.checkpoint.empty() ? "" : " and a checkpoint to " + o.checkpoint +
+                                                           " (go on with --resume " + o.checkpoint + ")"),
+                      signal);
   }
   if (!r.complete) {
     metadata["incomplete"] = "every device failed";

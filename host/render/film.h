@@ -36,6 +36,8 @@ struct Film {
   // which overstates the error of low-discrepancy samples (they are not independent).
   double estimatedRelMse() const;
   uint64_t passes() const { return passes_; }
+  // A film read back from a checkpoint holds passes 0 .. passes - 1.
+  void resumeAt(uint64_t passes) { passes_ = passes; }
   double count(size_t pixel) const { return sum[4 * pixel + 3]; }
   size_t pixels() const { return size_t(width) * size_t(height); }
 

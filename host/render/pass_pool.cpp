@@ -2,6 +2,10 @@
 #include "render/pass_pool.h"
 
 #include <algorithm>
+#include <csignal>
+#include <cstdlib>
+
+#include "render/checkpoint.h"
 
 namespace fh {
 namespace {
@@ -16,9 +20,15 @@ PassPool::PassPool(const RenderSettings& s, int workers)
       start_(std::chrono::steady_clock::now()),
       outstanding_(size_t(workers)),
       done_(size_t(workers), 0),
-      film_(s.width, s.height, s.surfaceAovs, s.noise > 0.0),
+      film_(s.resume ? *s.resume : Film(s.width, s.height, s.surfaceAovs, s.noise > 0.0)),
       progress_(s.progress),
-      merger_([this] { mergeInOrder(); }) {}
+      lastCheckpoint_(std::chrono::steady_clock::now()) {
+  // A resumed render goes on from the first pass its film lacks.
+  next_ = nextToMerge_ = uint32_t(film_.passes());
+  merged_ = film_.passes();
+  if (const char* kill = std::getenv("FREDHOLM_KILL_AFTER_PASSES"); kill && *kill) killAfter_ = std::atol(kill);
+  merger_ = std::thread([this] { mergeInOrder(); });
+}
 
 PassPool::~PassPool() { stopMerging(); }
 
@@ -91,6 +101,7 @@ uint64_t PassPool::passesDone(int worker) const {
 Film PassPool::finish(bool& complete) {
   stopMerging();
   std::lock_guard<std::mutex> lock(mutex_);
+  checkpoint(true);
   complete = noiseReached_ || (pending_.empty() && requeued_.empty() && !anyOutstanding());
   for (auto& [pass, samples] : pending_) {
     if (noiseReached_) break;  // beyond the pass that met the target
@@ -128,6 +139,7 @@ void PassPool::mergeInOrder() {
     spare_.push_back(std::move(samples));
     ++nextToMerge_;
     ++merged_;
+    checkpoint(false);
     if (check) noiseEstimate_ = estimate;
     showProgress();
     if (check && estimate <= settings_.noise) {
@@ -136,6 +148,25 @@ void PassPool::mergeInOrder() {
       return;
     }
   }
+}
+
+// Saves the film, every settings_.checkpointSeconds and at the end (final). A checkpoint
+// that cannot be written is a warning: the render is worth more than its checkpoint.
+void PassPool::checkpoint(bool final) {
+  if (settings_.checkpointPath.empty()) return;
+  if (!final && secondsSince(lastCheckpoint_) < settings_.checkpointSeconds) return;
+  try {
+    saveCheckpoint(settings_.checkpointPath, film_, settings_.fingerprint);
+  } catch (const std::exception& e) {
+    if (warnings_.empty()) warnings_.push_back(std::string("no checkpoint written: ") + e.what());
+  }
+  lastCheckpoint_ = std::chrono::steady_clock::now();
+  if (killAfter_ >= 0 && film_.passes() >= uint64_t(killAfter_)) raise(SIGKILL);  // a crash, for the tests
+}
+
+std::vector<std::string> PassPool::warnings() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return warnings_;
 }
 
 void PassPool::showProgress() {

@@ -13,6 +13,7 @@
 #include <map>
 #include <mutex>
 #include <set>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -33,10 +34,12 @@ class PassPool : public PassSource {
   void fail(int worker) override;
 
   uint64_t passesDone(int worker) const;
-  // Ends the render: merges whatever finished out of order (passes lost with every device
-  // leave gaps), closes the progress display, and returns the film. `complete` is false
-  // when some pass was never rendered.
+  // Ends the render: saves the checkpoint (the passes merged in order), merges whatever
+  // finished out of order (passes lost with every device leave gaps), closes the progress
+  // display, and returns the film. `complete` is false when some pass was never rendered.
   Film finish(bool& complete);
+  // Checkpoints that could not be written (the render goes on without them).
+  std::vector<std::string> warnings() const;
 
  private:
   bool anyOutstanding() const;
@@ -44,6 +47,7 @@ class PassPool : public PassSource {
   void mergeInOrder();
   void stopMerging();
   void showProgress();
+  void checkpoint(bool final);
 
   mutable std::mutex mutex_;
   std::condition_variable changed_;  // passes finished, or came back from a failed worker
@@ -61,6 +65,9 @@ class PassPool : public PassSource {
   Film film_;                                       // the merger's alone until finish()
   Progress progress_;
   bool stopping_ = false;
+  std::chrono::steady_clock::time_point lastCheckpoint_;
+  std::vector<std::string> warnings_;
+  long killAfter_ = -1;  // FREDHOLM_KILL_AFTER_PASSES (tests): SIGKILL once that many are saved
   bool noiseReached_ = false;
   double noiseEstimate_ = -1.0;  // the film's at the last check of a noise target
   std::thread merger_;

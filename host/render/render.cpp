@@ -120,6 +120,7 @@ class Render {
     result.stopped = settings_.stopRequested();
     for (const auto& w : warnings_)
       if (result.warnings.empty()) result.warnings = w;
+    for (const auto& w : pool_.warnings()) result.warnings.push_back(w);
     RenderStats& st = result.stats;
     st.seconds = seconds;
     st.devices = shares_;

@@ -5,9 +5,12 @@
 #include <array>
 #include <atomic>
 #include <cstddef>
+#include <memory>
 #include <string>
 
 namespace fh {
+
+struct Film;
 
 enum class Method { PT, NEE, MIS };
 const char* methodName(Method m);
@@ -50,6 +53,14 @@ struct RenderSettings {
   // Record each sample's first-surface layers (albedo, normal, depth: kernels/aovs.h) in the
   // same render; the film then keeps them beside the radiance (render/film.h).
   bool surfaceAovs = false;
+  // --checkpoint: the film (passes merged in order) saved to this file every
+  // checkpointSeconds and when the render ends, with the render's fingerprint
+  // (render/checkpoint.h); empty: none.
+  std::string checkpointPath;
+  double checkpointSeconds = 60.0;
+  std::string fingerprint;
+  // --resume: a saved film to go on from (it holds passes 0 .. resume->passes() - 1).
+  std::shared_ptr<const Film> resume;
   // Set (non-zero) to stop early, as Ctrl-C does: passes in flight are dropped, those
   // finished are kept. Null: never.
   const std::atomic<int>* stop = nullptr;

@@ -1,0 +1,106 @@
+// The checkpoint file: one text line (format, fingerprint, size, passes, which optional
+// sums follow), then the film's sums as raw doubles, in the order Film declares them.
+#include "render/checkpoint.h"
+
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include "base/atomic_file.h"
+#include "base/error.h"
+
+namespace fh {
+namespace {
+
+constexpr const char* kMagic = "fredholm-checkpoint-1";
+
+// FNV-1a, 64 bits, over whatever bytes are fed to it.
+class Fingerprint {
+ public:
+  template <typename T>
+  Fingerprint& add(const T& value) {
+    static_assert(std::is_trivially_copyable<T>::value, "raw bytes");
+    return bytes(&value, sizeof value);
+  }
+  template <typename T>
+  Fingerprint& add(const std::vector<T>& values) {
+    add(values.size());
+    return bytes(values.data(), values.size() * sizeof(T));
+  }
+  Fingerprint& add(const std::string& s) {
+    add(s.size());
+    return bytes(s.data(), s.size());
+  }
+  std::string hex() const {
+    std::ostringstream out;
+    out << std::hex << std::setw(16) << std::setfill('0') << hash_;
+    return out.str();
+  }
+
+ private:
+  Fingerprint& bytes(const void* data, size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < n; ++i) hash_ = (hash_ ^ p[i]) * 0x100000001b3ull;
+    return *this;
+  }
+  uint64_t hash_ = 0xcbf29ce484222325ull;
+};
+
+// The film's sums in file order.
+std::vector<const std::vector<double>*> sums(const Film& f) { return {&f.sum, &f.sumSq, &f.aovSum, &f.oddSum}; }
+std::vector<std::vector<double>*> sums(Film& f) { return {&f.sum, &f.sumSq, &f.aovSum, &f.oddSum}; }
+
+}  // namespace
+
+std::string renderFingerprint(const Scene& scene, const Camera& camera, const RenderSettings& s) {
+  Fingerprint f;
+  f.add(scene.positions).add(scene.indices).add(scene.triangleMaterial).add(scene.cornerNormals).add(scene.cornerUVs);
+  for (const Material& m : scene.materials)
+    f.add(m.kd).add(m.ks).add(m.ke).add(m.tf).add(m.ns).add(m.ni).add(m.d).add(m.illum).add(m.kdTexture);
+  for (const Texture& t : scene.textures) f.add(t.path);
+  f.add(camera.eye).add(camera.target).add(camera.up).add(camera.fovYDeg);
+  f.add(s.width).add(s.height).add(s.seed).add(s.method).add(s.maxDepth).add(s.rrDepth).add(s.env).add(s.filter);
+  f.add(s.noise > 0.0).add(s.surfaceAovs);
+  return f.hex();
+}
+
+void saveCheckpoint(const std::string& path, const Film& film, const std::string& fingerprint) {
+  std::ostringstream out;
+  out << kMagic << ' ' << fingerprint << ' ' << film.width << ' ' << film.height << ' ' << film.passes() << ' '
+      << film.aovSum.size() << ' ' << film.oddSum.size() << '\n';
+  for (const std::vector<double>* v : sums(film))
+    out.write(reinterpret_cast<const char*>(v->data()), std::streamsize(v->size() * 8));
+  writeTextAtomically(path, "--checkpoint", out.str());
+}
+
+Film loadCheckpoint(const std::string& path, const std::string& fingerprint, const std::string& flag) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(flag + " '" + path + "': cannot read the file");
+  std::string magic, saved;
+  int width = 0, height = 0;
+  uint64_t passes = 0;
+  size_t aovs = 0, odd = 0;
+  in >> magic >> saved >> width >> height >> passes >> aovs >> odd;
+  if (!in || magic != kMagic || in.get() != '\n' || width <= 0 || height <= 0 ||
+      uint64_t(width) * uint64_t(height) > (uint64_t(1) << 28))
+    throw Error(flag + " '" + path + "': not a fredholm checkpoint");
+  if (saved != fingerprint)
+    throw Error(flag + " '" + path + "': saved by a render of another scene, camera or settings (size, seed, "
+                "method, depths, environment, filter, --noise, --aovs); resume with the same ones");
+  Film film(width, height, aovs > 0, odd > 0);
+  if (film.aovSum.size() != aovs || film.oddSum.size() != odd)
+    throw Error(flag + " '" + path + "': not a fredholm checkpoint");
+  for (std::vector<double>* v : sums(film))
+    if (!in.read(reinterpret_cast<char*>(v->data()), std::streamsize(v->size() * 8)))
+      throw Error(flag + " '" + path + "': the file is cut short");
+  if (in.peek() != std::char_traits<char>::eof()) throw Error(flag + " '" + path + "': not a fredholm checkpoint");
+  // Every pass adds one sample to every pixel.
+  for (size_t p = 0; p < film.pixels(); ++p)
+    if (film.count(p) != double(passes)) throw Error(flag + " '" + path + "': the film's sample counts do not add up");
+  film.resumeAt(passes);
+  return film;
+}
+
+}  // namespace fh

@@ -1,0 +1,29 @@
+// Checkpoints: a render's film saved while it runs (--checkpoint), and a render resumed from
+// one (--resume). The film holds passes 0 .. n-1 merged in order, and a resumed render
+// merges pass n onward into it in the same order and precision, so a render killed at any
+// point and resumed gives the same image, to the bit, as one never interrupted.
+#pragma once
+#include <string>
+
+#include "render/film.h"
+#include "render/settings.h"
+#include "scene/camera.h"
+#include "scene/scene.h"
+
+namespace fh {
+
+// What makes two renders the same image: the scene's geometry, materials and textures (by
+// path), the camera, and the settings that change samples (size, seed, method, depths,
+// environment, filter, the sampler's replicates, the surface layers). Not the sample count
+// or time (a resumed render may go further), nor the strategy or devices (all compute the
+// same bits). A hex string.
+std::string renderFingerprint(const Scene& scene, const Camera& camera, const RenderSettings& settings);
+
+// Writes the film atomically (a temporary file renamed over `path`).
+void saveCheckpoint(const std::string& path, const Film& film, const std::string& fingerprint);
+
+// The film saved at `path`; throws fh::Error naming `flag` and the file if it cannot be
+// read, is cut short, or was saved by another render (another fingerprint).
+Film loadCheckpoint(const std::string& path, const std::string& fingerprint, const std::string& flag);
+
+}  // namespace fh
