@@ -63,6 +63,13 @@ TEST(Checkpoint, OtherSettingsOrADamagedFileAreRefused) {
   const auto cut = test::runFredholm(kRender + " --resume " + ckpt + " -o " + dir + "/c.exr");
   EXPECT_EQ(cut.exitCode, 1);
   EXPECT_NE(cut.output.find("cut short"), std::string::npos) << cut.output;
+  // A header claiming a huge film over a small file: refused before allocating it.
+  std::string header;
+  std::getline(std::ifstream(ckpt), header);
+  const std::string fingerprint = header.substr(header.find(' ') + 1, 16);
+  test::writeFile(dir + "/huge.fhc", "fredholm-checkpoint-1 " + fingerprint + " 16384 16384 3 0 0\n0123");
+  const auto huge = test::runFredholm(kRender + " --resume " + dir + "/huge.fhc -o " + dir + "/e.exr");
+  EXPECT_EQ(huge.exitCode, 1);
   test::writeFile(dir + "/junk.fhc", "not a checkpoint\n");
   const auto junk = test::runFredholm(kRender + " --resume " + dir + "/junk.fhc -o " + dir + "/d.exr");
   EXPECT_EQ(junk.exitCode, 1);

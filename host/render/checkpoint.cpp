@@ -89,9 +89,16 @@ Film loadCheckpoint(const std::string& path, const std::string& fingerprint, con
   if (saved != fingerprint)
     throw Error(flag + " '" + path + "': saved by a render of another scene, camera or settings (size, seed, "
                 "method, depths, environment, filter, --noise, --aovs); resume with the same ones");
-  Film film(width, height, aovs > 0, odd > 0);
-  if (film.aovSum.size() != aovs || film.oddSum.size() != odd)
+  // The sums' sizes follow from the header: checked against the file before allocating.
+  const uint64_t pixels = uint64_t(width) * uint64_t(height);
+  if ((aovs != 0 && aovs != pixels * kAovSumsPerPixel) || (odd != 0 && odd != pixels * 3))
     throw Error(flag + " '" + path + "': not a fredholm checkpoint");
+  const auto body = in.tellg();
+  in.seekg(0, std::ios::end);
+  const uint64_t bytes = uint64_t(in.tellg() - body);
+  in.seekg(body);
+  if (bytes != (8 * pixels + aovs + odd) * 8) throw Error(flag + " '" + path + "': the file is cut short");
+  Film film(width, height, aovs > 0, odd > 0);
   for (std::vector<double>* v : sums(film))
     if (!in.read(reinterpret_cast<char*>(v->data()), std::streamsize(v->size() * 8)))
       throw Error(flag + " '" + path + "': the file is cut short");

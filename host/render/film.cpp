@@ -7,13 +7,9 @@
 
 namespace fh {
 
-namespace {
-constexpr size_t kAovSums = 8;  // albedo rgb, normal xyz, depth, hits
-}
-
 Film::Film(int w, int h, bool surfaceAovs, bool twoReplicates)
     : width(w), height(h), sum(pixels() * 4, 0.0), sumSq(pixels() * 4, 0.0),
-      aovSum(surfaceAovs ? pixels() * kAovSums : 0, 0.0), oddSum(twoReplicates ? pixels() * 3 : 0, 0.0) {}
+      aovSum(surfaceAovs ? pixels() * kAovSumsPerPixel : 0, 0.0), oddSum(twoReplicates ? pixels() * 3 : 0, 0.0) {}
 
 void Film::addPass(const std::vector<float>& samples) {
   for (size_t i = 0; i < sum.size(); ++i) {
@@ -29,7 +25,7 @@ void Film::addPass(const std::vector<float>& samples) {
   const float* aovs = samples.data() + sum.size();
   for (size_t p = 0; p < pixels(); ++p) {
     const float* in = aovs + kAovFloatsPerPixel * p;  // albedo rgb, flag, normal xyz, distance
-    double* out = &aovSum[kAovSums * p];
+    double* out = &aovSum[kAovSumsPerPixel * p];
     for (size_t c = 0; c < 3; ++c) {
       out[c] += in[c];
       out[3 + c] += in[4 + c];
@@ -67,22 +63,22 @@ double Film::estimatedRelMse() const {
 std::vector<float> Film::albedo() const {
   std::vector<float> v;
   for (size_t p = 0; p < pixels() && hasSurfaceAovs(); ++p)
-    for (size_t c = 0; c < 3; ++c) v.push_back(count(p) > 0 ? float(aovSum[kAovSums * p + c] / count(p)) : 0.f);
+    for (size_t c = 0; c < 3; ++c) v.push_back(count(p) > 0 ? float(aovSum[kAovSumsPerPixel * p + c] / count(p)) : 0.f);
   return v;
 }
 
 std::vector<float> Film::normal() const {
   std::vector<float> v;
   for (size_t p = 0; p < pixels() && hasSurfaceAovs(); ++p)
-    for (size_t c = 0; c < 3; ++c) v.push_back(count(p) > 0 ? float(aovSum[kAovSums * p + 3 + c] / count(p)) : 0.f);
+    for (size_t c = 0; c < 3; ++c) v.push_back(count(p) > 0 ? float(aovSum[kAovSumsPerPixel * p + 3 + c] / count(p)) : 0.f);
   return v;
 }
 
 std::vector<float> Film::depth() const {
   std::vector<float> v;
   for (size_t p = 0; p < pixels() && hasSurfaceAovs(); ++p) {
-    const double hits = aovSum[kAovSums * p + 7];
-    v.push_back(hits > 0 ? float(aovSum[kAovSums * p + 6] / hits) : kNoDepth);
+    const double hits = aovSum[kAovSumsPerPixel * p + 7];
+    v.push_back(hits > 0 ? float(aovSum[kAovSumsPerPixel * p + 6] / hits) : kNoDepth);
   }
   return v;
 }

@@ -14,6 +14,8 @@ namespace fh {
 // A pass's first-surface layers per pixel, after its radiance (kernels/aovs.h): albedo rgb,
 // a flag, normal xyz, the camera ray's hit distance.
 constexpr size_t kAovFloatsPerPixel = 8;
+// The film's sums of them per pixel (Film::aovSum): albedo rgb, normal xyz, depth, hits.
+constexpr size_t kAovSumsPerPixel = 8;
 
 struct Film {
   Film() = default;
