@@ -46,6 +46,16 @@ TEST(Checkpoint, ARenderCanBeExtended) {
   EXPECT_TRUE(readImage(dir + "/24.exr").rgb == readImage(dir + "/straight.exr").rgb);
 }
 
+// A render stopped by its noise target, resumed: nothing more to do, the same image.
+TEST(Checkpoint, ARenderThatMetItsNoiseTargetStaysAsItWas) {
+  const std::string dir = test::tempDir("noise-resume");
+  const std::string render = "render --width 24 --height 24 --noise 3e-3 --seed 3";
+  ASSERT_EQ(test::runFredholm(render + " --checkpoint " + dir + "/c.fhc -o " + dir + "/a.exr").exitCode, 0);
+  const auto r = test::runFredholm(render + " --resume " + dir + "/c.fhc -o " + dir + "/b.exr");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_TRUE(readImage(dir + "/a.exr").rgb == readImage(dir + "/b.exr").rgb);
+}
+
 TEST(Checkpoint, OtherSettingsOrADamagedFileAreRefused) {
   const std::string dir = test::tempDir("refuse");
   const std::string ckpt = dir + "/c.fhc";

@@ -26,6 +26,9 @@ PassPool::PassPool(const RenderSettings& s, int workers)
   // A resumed render goes on from the first pass its film lacks.
   next_ = nextToMerge_ = uint32_t(film_.passes());
   merged_ = film_.passes();
+  // ... unless it met its noise target already (a render that stopped there).
+  noiseReached_ = s.resume && s.noise > 0.0 && film_.passes() >= kNoiseMinPasses &&
+                  film_.estimatedRelMse() <= s.noise;
   if (const char* kill = std::getenv("FREDHOLM_KILL_AFTER_PASSES"); kill && *kill) killAfter_ = std::atol(kill);
   merger_ = std::thread([this] { mergeInOrder(); });
 }
