@@ -1,0 +1,23 @@
+// Checkpoint files, as --resume reads them: the fingerprint a render would expect is taken
+// from the input's own header (else nothing past it is reached); any file must load to a
+// consistent film or throw fh::Error.
+#include <string>
+
+#include "base/error.h"
+#include "fuzz_support.h"
+#include "render/checkpoint.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  const size_t space = text.find(' ');
+  const std::string fingerprint = space == std::string::npos ? "" : text.substr(space + 1, 16);
+  const std::string path = fh::fuzz::writeScratch("checkpoint.fhc", data, size);
+  try {
+    const fh::Film film = fh::loadCheckpoint(path, fingerprint, "--resume");
+    if (film.sum.size() != 4 * film.pixels() || film.count(0) != double(film.passes())) __builtin_trap();
+    film.image();
+    film.estimatedRelMse();
+  } catch (const fh::Error&) {
+  }
+  return 0;
+}
