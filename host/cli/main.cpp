@@ -38,8 +38,8 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
   rendering->add_option("--method", o.method, "pt (BRDF sampling), nee (light sampling) or mis (both)")
       ->capture_default_str();
   rendering->add_option("--noise", o.noise,
-                        "Stop once the image's relMSE, estimated from each pixel's sample variance, is at most "
-                        "this (e.g. 1e-3); --spp and --time still cap the render");
+                        "Stop once the image's relMSE, estimated from two independently scrambled halves of the "
+                        "samples (even and odd passes), is at most this (e.g. 1e-3); --spp and --time still cap it");
   rendering->add_option("--max-depth", o.maxDepth, "Most bounces (Russian roulette ends most paths sooner)")
       ->capture_default_str();
   rendering->add_option("--rr-depth", o.rrDepth,
