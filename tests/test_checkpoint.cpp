@@ -93,7 +93,7 @@ TEST(Checkpoint, CtrlCLeavesACheckpointToResumeFrom) {
   const std::string dir = test::tempDir("ctrl-c");
   const std::string size = "render --width 32 --height 32 --seed 5", render = size + " --spp 8192";
   ASSERT_EQ(test::runFredholm(size + " --spp 1 -o " + dir + "/warm.exr").exitCode, 0);  // builds the kernels
-  const auto stopped = test::runCommand(std::string("timeout --foreground --preserve-status -s INT 2 ") +
+  const auto stopped = test::runCommand(std::string("timeout --foreground --preserve-status -s INT 1 ") +
                                         FREDHOLM_BINARY + " " + render + " --checkpoint " + dir +
                                         "/c.fhc -o " + dir + "/part.exr");
   ASSERT_EQ(stopped.exitCode, 130) << stopped.output;
