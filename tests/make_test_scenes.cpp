@@ -31,6 +31,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "scene/icosphere.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -113,40 +115,16 @@ void writeCamera(const fs::path& path, P3 eye, P3 target, double fovYDeg) {
   writeText(path, j.dump() + "\n");
 }
 
-// An icosphere: the icosahedron's faces split `levels` times (20 * 4^levels triangles),
-// its vertices on the unit sphere, faces outward.
+// The unit icosphere (scene/icosphere.h) with double coordinates, as the scenes are written.
 struct Mesh {
   std::vector<P3> vertices;
-  std::vector<std::array<int, 3>> faces;
+  std::vector<std::array<unsigned, 3>> faces;
 };
 Mesh icosphere(int levels) {
-  const double g = (1.0 + std::sqrt(5.0)) / 2.0;
+  const fh::IndexedMesh unit = fh::icosphere(levels);
   Mesh m;
-  m.vertices = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
-                {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
-  for (P3& v : m.vertices) v = normalize(v);
-  m.faces = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-             {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-             {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
-  for (int level = 0; level < levels; ++level) {
-    std::map<std::pair<int, int>, int> midpoints;
-    auto midpoint = [&](int a, int b) {
-      const auto key = std::minmax(a, b);
-      auto it = midpoints.find(key);
-      if (it != midpoints.end()) return it->second;
-      m.vertices.push_back(normalize((m.vertices[size_t(a)] + m.vertices[size_t(b)]) * 0.5));
-      return midpoints[key] = int(m.vertices.size()) - 1;
-    };
-    std::vector<std::array<int, 3>> finer;
-    for (const auto& f : m.faces) {
-      const int ab = midpoint(f[0], f[1]), bc = midpoint(f[1], f[2]), ca = midpoint(f[2], f[0]);
-      finer.push_back({f[0], ab, ca});
-      finer.push_back({f[1], bc, ab});
-      finer.push_back({f[2], ca, bc});
-      finer.push_back({ab, bc, ca});
-    }
-    m.faces = std::move(finer);
-  }
+  for (const auto& v : unit.vertices) m.vertices.push_back({v[0], v[1], v[2]});
+  m.faces = unit.faces;
   return m;
 }
 
@@ -154,7 +132,7 @@ void addMesh(ObjFile& obj, const Mesh& mesh, P3 centre, double radius, double (*
   const int base = obj.vertex(centre + mesh.vertices[0] * (radius * (bump ? bump(mesh.vertices[0]) : 1.0))) - 1;
   for (size_t i = 1; i < mesh.vertices.size(); ++i)
     obj.vertex(centre + mesh.vertices[i] * (radius * (bump ? bump(mesh.vertices[i]) : 1.0)));
-  for (const auto& f : mesh.faces) obj.face({base + f[0] + 1, base + f[1] + 1, base + f[2] + 1});
+  for (const auto& f : mesh.faces) obj.face({base + int(f[0]) + 1, base + int(f[1]) + 1, base + int(f[2]) + 1});
 }
 
 // The blob's radius along a unit direction: smooth lumps, always positive (a star-shaped,

@@ -19,6 +19,7 @@
 #include "accel/bvh.h"
 #include "base/vec.h"
 #include "bench/ray_workload.h"
+#include "scene/icosphere.h"
 #include "scene/scene_loader.h"
 #include "scene_builder.h"
 #include "test_support.h"
@@ -283,30 +284,9 @@ INSTANTIATE_TEST_SUITE_P(
 
 // An icosphere (subdivided icosahedron): closed, every edge shared by two triangles.
 Scene icosphere(int subdivisions, float scale, const float3& offset) {
-  const float g = (1.f + std::sqrt(5.f)) / 2.f;
-  std::vector<float3> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
-                           {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
-  std::vector<std::array<unsigned, 3>> f = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11},
-                                            {1, 5, 9}, {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                            {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8}, {3, 8, 9},
-                                            {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
-  for (auto& p : v) p = normalize(p);
-  for (int s = 0; s < subdivisions; ++s) {
-    std::map<std::pair<unsigned, unsigned>, unsigned> mid;
-    auto midpoint = [&](unsigned a, unsigned b) {
-      const auto key = std::minmax(a, b);
-      auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      v.push_back(normalize((v[a] + v[b]) * 0.5f));
-      return mid[key] = unsigned(v.size() - 1);
-    };
-    std::vector<std::array<unsigned, 3>> next;
-    for (const auto& t : f) {
-      const unsigned a = midpoint(t[0], t[1]), b = midpoint(t[1], t[2]), c = midpoint(t[2], t[0]);
-      next.insert(next.end(), {{t[0], a, c}, {t[1], b, a}, {t[2], c, b}, {a, b, c}});
-    }
-    f = next;
-  }
+  const IndexedMesh mesh = fh::icosphere(subdivisions);
+  const auto& v = mesh.vertices;
+  const auto& f = mesh.faces;
   Scene scene;
   for (const auto& p : v) {
     const float3 q = p * scale + offset;

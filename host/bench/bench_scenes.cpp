@@ -8,6 +8,7 @@
 
 #include "base/error.h"
 #include "base/vec.h"
+#include "scene/icosphere.h"
 #include "scene/scene_loader.h"
 
 namespace fh {
@@ -54,29 +55,6 @@ Scene bunnyCrowd(const std::string& dir) {
   return scene;
 }
 
-// An icosphere's triangles (20 * 4^levels), outward, unit radius, as corner positions.
-std::vector<float3> icosphereCorners(int levels) {
-  const float g = (1.f + std::sqrt(5.f)) / 2.f;
-  std::vector<float3> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
-                           {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
-  const int f[20][3] = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                        {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-                        {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
-  std::vector<float3> corners;
-  for (const auto& face : f)
-    for (int k : face) corners.push_back(normalize(v[size_t(k)]));
-  for (int level = 0; level < levels; ++level) {
-    std::vector<float3> finer;
-    for (size_t t = 0; t < corners.size(); t += 3) {
-      const float3 a = corners[t], b = corners[t + 1], c = corners[t + 2];
-      const float3 ab = normalize(a + b), bc = normalize(b + c), ca = normalize(c + a);
-      for (const float3& p : {a, ab, ca, ab, b, bc, ca, bc, c, ab, bc, ca}) finer.push_back(p);
-    }
-    corners = std::move(finer);
-  }
-  return corners;
-}
-
 // About `count` triangles for the scaling chart: a floor under a square grid of spheres of
 // 1280 triangles each (fewer, finer spheres below that), bumped so no two are alike.
 Scene sphereField(size_t count) {
@@ -86,8 +64,8 @@ Scene sphereField(size_t count) {
   scene.materials.push_back(grey);
   int levels = 3;  // 1280 triangles a sphere
   while (levels > 0 && size_t(20) << (2 * levels) > count) --levels;
-  const std::vector<float3> sphere = icosphereCorners(levels);
-  const size_t perSphere = sphere.size() / 3;
+  const IndexedMesh sphere = icosphere(levels);
+  const size_t perSphere = sphere.faces.size();
   const size_t spheres = std::max<size_t>(1, (count + perSphere / 2) / perSphere);
   const int side = int(std::ceil(std::sqrt(double(spheres))));
   auto add = [&](const float3& p) {
@@ -103,10 +81,12 @@ Scene sphereField(size_t count) {
   for (size_t i = 0; i < spheres; ++i) {
     const float x = -half + 1.f + 2.f * float(i % size_t(side)), z = -half + 1.f + 2.f * float(i / size_t(side));
     const float radius = 0.6f + 0.3f * std::sin(1.7f * float(i));
-    for (const float3& c : sphere) {
-      const float bump = 1.f + 0.1f * std::sin(7.f * c[0] + float(i)) * std::cos(5.f * c[2]);
-      add(float3{x, radius, z} + c * (radius * bump));
-    }
+    for (const auto& face : sphere.faces)
+      for (unsigned k : face) {
+        const float3& c = sphere.vertices[k];
+        const float bump = 1.f + 0.1f * std::sin(7.f * c[0] + float(i)) * std::cos(5.f * c[2]);
+        add(float3{x, radius, z} + c * (radius * bump));
+      }
     scene.triangleMaterial.insert(scene.triangleMaterial.end(), perSphere, 0);
   }
   scene.camera.eye = {0.f, 0.9f * half + 2.f, 1.6f * half + 2.f};
