@@ -6,6 +6,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -26,7 +27,7 @@ struct Layers {
 constexpr int kSize = 16;
 
 Layers renderLayers(const Scene& scene, const Camera& camera, int spp, Method method = Method::MIS) {
-  static DeviceContext dc(selectDevices(listDevices(), "").front());
+  DeviceContext& dc = test::defaultDevice();
   const Bvh bvh = buildBvh(scene);
   RenderSettings s = test::renderSettings();
   s.width = s.height = kSize;
@@ -62,6 +63,18 @@ Camera lookingDown(float height) {
   return c;
 }
 
+// Pixel (i, j) saw, with every sample, a surface of albedo `albedo` whose normal is
+// (0, 0, normalZ), at the camera ray's distance to the plane z = 0 from `height`.
+void expectSurfaceAt(const Layers& l, int i, int j, const std::array<float, 3>& albedo, float normalZ,
+                     double height) {
+  const size_t p = size_t(j * kSize + i);
+  for (size_t c = 0; c < 3; ++c) EXPECT_NEAR(l.albedo[3 * p + c], albedo[c], 1e-6f);
+  EXPECT_NEAR(l.normal[3 * p + 2], normalZ, 1e-6f);
+  // The pixel's samples spread over its footprint; the mean distance is the centre's to
+  // second order.
+  EXPECT_NEAR(l.depth[p], centreRayDepth(i, j, height, 30.0), 1e-3 * l.depth[p]);
+}
+
 // A diffuse plane under the left half of the view, nothing under the right half: the
 // plane's albedo and normal exactly, its distance per pixel, and nothing where rays escape.
 TEST(SurfaceAovs, DiffusePlaneAndEmptySky) {
@@ -73,13 +86,7 @@ TEST(SurfaceAovs, DiffusePlaneAndEmptySky) {
       const size_t p = size_t(j * kSize + i);
       SCOPED_TRACE("pixel " + std::to_string(i) + "," + std::to_string(j));
       if (i < kSize / 2) {  // all on the plane (x < 0)
-        EXPECT_NEAR(l.albedo[3 * p], 0.2f, 1e-6f);
-        EXPECT_NEAR(l.albedo[3 * p + 1], 0.4f, 1e-6f);
-        EXPECT_NEAR(l.albedo[3 * p + 2], 0.6f, 1e-6f);
-        EXPECT_NEAR(l.normal[3 * p + 2], 1.f, 1e-6f);
-        // The pixel's samples spread over its footprint; the mean distance is the centre's
-        // to second order.
-        EXPECT_NEAR(l.depth[p], centreRayDepth(i, j, 3.0, 30.0), 1e-3 * l.depth[p]);
+        expectSurfaceAt(l, i, j, {0.2f, 0.4f, 0.6f}, 1.f, 3.0);
       } else {  // all escape
         EXPECT_EQ(l.albedo[3 * p], 0.f);
         EXPECT_EQ(l.normal[3 * p + 2], 0.f);
@@ -100,13 +107,8 @@ TEST(SurfaceAovs, LookThroughMirrorsToTheFirstNonSpecularSurface) {
   const Layers l = renderLayers(scene, lookingDown(2.f), 8);
   for (int j = 0; j < kSize; ++j)
     for (int i = 0; i < kSize; ++i) {
-      const size_t p = size_t(j * kSize + i);
       SCOPED_TRACE("pixel " + std::to_string(i) + "," + std::to_string(j));
-      EXPECT_NEAR(l.albedo[3 * p], 0.1f, 1e-6f);
-      EXPECT_NEAR(l.albedo[3 * p + 1], 0.8f, 1e-6f);
-      EXPECT_NEAR(l.albedo[3 * p + 2], 0.3f, 1e-6f);
-      EXPECT_NEAR(l.normal[3 * p + 2], -1.f, 1e-6f);
-      EXPECT_NEAR(l.depth[p], centreRayDepth(i, j, 2.0, 30.0), 1e-3 * l.depth[p]);
+      expectSurfaceAt(l, i, j, {0.1f, 0.8f, 0.3f}, -1.f, 2.0);
     }
 }
 
@@ -115,7 +117,7 @@ TEST(SurfaceAovs, LookThroughMirrorsToTheFirstNonSpecularSurface) {
 TEST(SurfaceAovs, TheImageIsTheSameBitsWithOrWithoutThem) {
   const std::string dir = test::tempDir("aovs-features");
   const Scene scene = loadScene(test::writeFeatureScene(dir));
-  static DeviceContext dc(selectDevices(listDevices(), "").front());
+  DeviceContext& dc = test::defaultDevice();
   const Bvh bvh = buildBvh(scene);
   for (Method m : {Method::PT, Method::NEE, Method::MIS}) {
     RenderSettings s = test::renderSettings();

@@ -18,7 +18,7 @@ namespace fh {
 namespace {
 
 Film renderFilm(const Scene& scene, int width, int height, int spp, double noise, unsigned seed) {
-  static DeviceContext dc(selectDevices(listDevices(), "").front());
+  DeviceContext& dc = test::defaultDevice();
   const Bvh bvh = buildBvh(scene);
   RenderSettings s = test::renderSettings();
   s.width = width;
@@ -58,7 +58,7 @@ TEST(NoiseTarget, EstimateMatchesTheTruthOnTheVeachPlates) {
 // Stopping is decided on merged passes only, so the image for a seed and target is the
 // same whatever the wavefront size (which changes how many passes are in flight).
 TEST(NoiseTarget, TheStopIsDeterministic) {
-  static DeviceContext dc(selectDevices(listDevices(), "").front());
+  DeviceContext& dc = test::defaultDevice();
   const Scene scene = loadDefaultScene();
   const Bvh bvh = buildBvh(scene);
   RenderSettings s = test::renderSettings();

@@ -44,7 +44,7 @@ struct Rendered {
 
 Rendered render(const Scene& scene, const Camera& camera, Method method, int size, int spp, unsigned seed = 1,
                 size_t wavefront = 0, std::array<float, 3> env = {0, 0, 0}, int maxDepth = 64) {
-  static DeviceContext dc(selectDevices(listDevices(), "").front());
+  DeviceContext& dc = test::defaultDevice();
   const Bvh bvh = buildBvh(scene);
   RenderSettings s = test::renderSettings();
   s.width = s.height = size;
@@ -252,7 +252,7 @@ TEST(PathTracer, SpecializedAndAllFeatureKernelsAgree) {
   // The Cornell box needs none of the material features; a kernel compiled with all of
   // them must render the same image (the same samples, up to float rounding in paths).
   const Scene scene = loadDefaultScene();
-  static DeviceContext dc(selectDevices(listDevices(), "").front());
+  DeviceContext& dc = test::defaultDevice();
   const Bvh bvh = buildBvh(scene);
   RenderSettings s = test::renderSettings();
   s.width = s.height = 16;
@@ -274,7 +274,7 @@ TEST(PathTracer, SpecializedAndAllFeatureKernelsAgree) {
 // for every method.
 TEST(PathTracer, EveryStrategyRendersTheSameBits) {
   const Scene scene = loadScene(test::writeFeatureScene(test::tempDir("strategies")));
-  static DeviceContext dc(selectDevices(listDevices(), "").front());
+  DeviceContext& dc = test::defaultDevice();
   const Bvh bvh = buildBvh(scene);
   Camera camera;
   camera.eye = {0.f, 1.f, 2.5f};

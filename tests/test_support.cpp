@@ -12,9 +12,15 @@
 #include <vector>
 
 #include "cli/flags.h"
+#include "device/devices.h"
 #include "image/image_io.h"
 
 namespace fh::test {
+
+DeviceContext& defaultDevice() {
+  static DeviceContext dc(selectDevices(listDevices(), "").front());
+  return dc;
+}
 
 RenderSettings renderSettings() {
   RenderSettings s;

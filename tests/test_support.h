@@ -5,9 +5,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "device/device_context.h"
 #include "render/settings.h"
 
 namespace fh::test {
+
+// The first device (fredholm's default), set up once per test process: the rendering tests
+// share its context, so kernels compile once.
+DeviceContext& defaultDevice();
 
 // RenderSettings{} with the strategy this run tests: FREDHOLM_TEST_STRATEGY (CTest runs the
 // rendering suites under several, tests/CMakeLists.txt), else auto.

@@ -71,6 +71,10 @@ struct KindTimings {
   int passes = 1;  // traces of the rays per repeat and tracer
   std::vector<double> wall, kernel, ratio;
   std::vector<std::vector<double>> external;  // per external API
+  // Millions of rays per second over the median repeat of `seconds`, for `rays` per trace.
+  double mrays(unsigned rays, const std::vector<double>& seconds) const {
+    return double(rays) * passes / median(seconds) * 1e-6;
+  }
 };
 
 struct RayKind {
@@ -115,17 +119,17 @@ class SceneBench {
     cl::Buffer out = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, n * 16ull, "bench hits");
     std::vector<int> theirs;
     const KindTimings t = timeInterleaved(dc, caster, work, kind, out, theirs);
+    const double mrays = t.mrays(n, t.wall), kernelMrays = t.mrays(n, t.kernel);
     nlohmann::json record = {{"scene", name_},
                              {"device", dc.info.name},
                              {"triangles", scene_.triangleCount()},
                              {"ray_kind", kind.name},
                              {"rays", n},
-                             {"mrays_per_s", n * t.passes / median(t.wall) * 1e-6},
-                             {"kernel_mrays_per_s", n * t.passes / median(t.kernel) * 1e-6}};
+                             {"mrays_per_s", mrays},
+                             {"kernel_mrays_per_s", kernelMrays}};
     std::cout << std::left << std::setw(12) << name_ << std::right << std::setw(4) << deviceIndex << std::setw(10)
               << scene_.triangleCount() << std::setw(9) << kind.name << std::setw(9) << n << std::fixed
-              << std::setprecision(2) << std::setw(10) << n * t.passes / median(t.wall) * 1e-6 << std::setw(10)
-              << n * t.passes / median(t.kernel) * 1e-6;
+              << std::setprecision(2) << std::setw(10) << mrays << std::setw(10) << kernelMrays;
     if (external_) reportExternal(dc, work, kind, out, t, theirs, record);
     std::cout << std::defaultfloat << "\n";
     return record;
@@ -145,19 +149,19 @@ class SceneBench {
     KindTimings t;
     t.external.resize(apis.size());
     std::vector<double> seconds(apis.size());
-    // A repeat traces the rays `passes` times with each tracer: enough that the scheduler's
-    // hiccups (milliseconds) are small against it on scenes that trace in a few.
-    int passes = 1;
+    // A repeat traces the rays t.passes times with each tracer (set after the warm-up): enough
+    // that the scheduler's hiccups (milliseconds) are small against it on scenes that trace
+    // in a few.
     auto traceExternal = [&] {
       for (size_t a = 0; a < apis.size(); ++a) {
         seconds[a] = 0.0;
-        for (int i = 0; i < passes; ++i)
+        for (int i = 0; i < t.passes; ++i)
           seconds[a] += external_->trace(apis[a], org, dir, kind.occlusion, kind.coherent, o_.threads, theirs);
       }
     };
     auto traceOurs = [&] {
       LaunchTiming sum;
-      for (int i = 0; i < passes; ++i) {
+      for (int i = 0; i < t.passes; ++i) {
         const LaunchTiming one = timeLaunch(dc, [&](cl::Event* e) {
           if (kind.occlusion) caster.intersectAny(kind.rays.org, kind.rays.dir, out, n, e);
           else caster.intersectClosest(kind.rays.org, kind.rays.dir, out, n, e);
@@ -172,7 +176,7 @@ class SceneBench {
       const LaunchTiming ours = traceOurs();
       if (r % 2 == 0) traceExternal();
       if (r < 0) {
-        passes = t.passes = std::max(1, int(std::ceil(kRepeatSeconds / ours.wallSeconds)));
+        t.passes = std::max(1, int(std::ceil(kRepeatSeconds / ours.wallSeconds)));
         continue;
       }
       t.wall.push_back(ours.wallSeconds);
@@ -203,7 +207,7 @@ class SceneBench {
     double best = 0.0;
     const std::vector<std::string> apis = external_->apis();
     for (size_t a = 0; a < apis.size(); ++a) {
-      const double mrays = n * t.passes / median(t.external[a]) * 1e-6;
+      const double mrays = t.mrays(n, t.external[a]);
       record["embree_" + apis[a] + "_mrays_per_s"] = mrays;
       best = std::max(best, mrays);
       std::cout << std::setw(10) << mrays;

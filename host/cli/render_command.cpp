@@ -1,9 +1,7 @@
 // `fredholm render`: flags checked before any work, then scene, camera, BVH, one render on
 // every device --device selects, and the image with its metadata.
-#include <cctype>
 #include <chrono>
 #include <cmath>
-#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -176,9 +174,7 @@ std::vector<std::string> checkOutputs(RenderOptions& o, RenderSettings& settings
   // An explicit -o is never overwritten without --force; the default name steps aside.
   if (o.output.empty()) o.output = firstFreeName(layers.empty() ? "fredholm.png" : "fredholm.exr");
   checkOutputPath(o.output, o.force);
-  std::string extension = std::filesystem::path(o.output).extension().string();
-  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
-  if (!layers.empty() && extension != ".exr")
+  if (!layers.empty() && extensionOf(o.output) != ".exr")
     throw Error("--aovs: layers are written into one EXR; -o '" + o.output + "' is not an .exr file");
   if (!o.statsFile.empty()) checkOutputFile(o.statsFile, o.force, "--stats");
   // The checkpoint a render resumes from is its own to overwrite.
@@ -192,24 +188,24 @@ std::vector<std::string> checkOutputs(RenderOptions& o, RenderSettings& settings
 
 // The render's facts in the image file's metadata.
 std::map<std::string, std::string> imageMetadata(const RenderOptions& o, const Scene& scene, const RenderResult& r,
-                                                 const std::string& method, double spp, double seconds) {
+                                                 const std::string& method, double spp, double seconds,
+                                                 double estimatedRelMse) {
   std::map<std::string, std::string> metadata = {
       {"scene", scene.sourcePath},       {"spp", formatSeconds(spp)},          {"method", method},
       {"device", r.stats.contributors()}, {"seed", std::to_string(o.seed)},     {"seconds", formatSeconds(seconds)},
       {"filter", o.filter},              {"max_depth", std::to_string(o.maxDepth)}};
   if (!o.aovs.empty()) metadata["aovs"] = o.aovs;
-  if (o.aov.empty()) metadata["estimated_relmse"] = formatScientific(r.film.estimatedRelMse());
+  if (o.aov.empty()) metadata["estimated_relmse"] = formatScientific(estimatedRelMse);
   return metadata;
 }
 
 void printSummary(const RenderOptions& o, const RenderSettings& settings, const Scene& scene, const RenderResult& r,
-                  const std::string& method, double spp, double seconds) {
+                  const std::string& method, double spp, double seconds, double noise) {
   std::cerr << "fredholm: rendered " << scene.sourcePath << " (" << scene.triangleCount() << " triangles, "
             << scene.lights.size() << " emissive; " << (o.allFeatures ? "all features" : sceneFeatures(scene).describe())
             << ") with " << method << ", " << o.width << "x" << o.height << ", " << spp << " spp on "
             << r.stats.contributors() << " in " << formatSeconds(seconds) << " s\n";
   if (settings.noise > 0) {
-    const double noise = r.film.estimatedRelMse();
     const bool met = noise <= settings.noise;
     std::cerr << "fredholm: estimated relMSE " << formatScientific(noise) << (met ? " meets" : " has not reached")
               << " --noise " << formatScientific(settings.noise) << (met ? "" : " (stopped by --spp or --time)") << "\n";
@@ -250,7 +246,8 @@ int runRender(RenderOptions o) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // The film's samples per pixel: a noise target drops the passes finished past it.
   const double spp = debugView ? double(r.stats.samples) / double(r.film.pixels()) : r.film.count(0);
-  std::map<std::string, std::string> metadata = imageMetadata(o, scene, r, method, spp, seconds);
+  const double estimatedRelMse = debugView ? 0.0 : r.film.estimatedRelMse();
+  std::map<std::string, std::string> metadata = imageMetadata(o, scene, r, method, spp, seconds, estimatedRelMse);
   const Image image = imageWithLayers(r.film, layers);
   const std::string passes = std::to_string(uint64_t(r.film.count(0))) + " passes";
   if (r.stopped) {
@@ -270,7 +267,7 @@ int runRender(RenderOptions o) {
                 " finished so far to " + o.output);
   }
   writeImage(o.output, image, metadata);
-  printSummary(o, settings, scene, r, method, spp, seconds);
+  printSummary(o, settings, scene, r, method, spp, seconds, estimatedRelMse);
   std::cout << "wrote " << o.output << "\n";
   return 0;
 }

@@ -22,12 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string extensionOf(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext;
-}
-
 // Debian 12's OpenImageIO (2.4) reads PFM but has no PFM writer, so fredholm writes it:
 // "PF", width height, a negative scale for little-endian, then rows bottom to top.
 void writePfm(const std::string& path, const Image& image) {
@@ -67,6 +61,12 @@ Image readPfm(const std::string& path) {
 }
 
 }  // namespace
+
+std::string extensionOf(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
 
 float linearToSrgb(float x) {
   x = std::clamp(x, 0.f, 1.f);

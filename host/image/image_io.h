@@ -32,6 +32,9 @@ ImageEncoding checkOutputPath(const std::string& path, bool force, const std::st
 // writable, it is not a directory, and it does not exist unless `force`.
 void checkOutputFile(const std::string& path, bool force, const std::string& flag);
 
+// The path's extension in lower case (".exr"), which picks the format.
+std::string extensionOf(const std::string& path);
+
 // The first of base.ext, base-1.ext, base-2.ext ... that does not exist.
 std::string firstFreeName(const std::string& path);
 

@@ -62,7 +62,7 @@ std::string renderFingerprint(const Scene& scene, const Camera& camera, const Re
   for (const Texture& t : scene.textures) f.add(t.path);
   f.add(camera.eye).add(camera.target).add(camera.up).add(camera.fovYDeg);
   f.add(s.width).add(s.height).add(s.seed).add(s.method).add(s.maxDepth).add(s.rrDepth).add(s.env).add(s.filter);
-  f.add(s.noise > 0.0).add(s.surfaceAovs);
+  f.add(s.replicates()).add(s.surfaceAovs);
   return f.hex();
 }
 

@@ -60,19 +60,17 @@ double Film::estimatedRelMse() const {
   return pixels() ? total / double(3 * pixels()) : 0.0;
 }
 
-std::vector<float> Film::albedo() const {
+// Channels first .. first + 2 of the layer sums, over each pixel's samples.
+std::vector<float> Film::aovMean(size_t first) const {
   std::vector<float> v;
   for (size_t p = 0; p < pixels() && hasSurfaceAovs(); ++p)
-    for (size_t c = 0; c < 3; ++c) v.push_back(count(p) > 0 ? float(aovSum[kAovSumsPerPixel * p + c] / count(p)) : 0.f);
+    for (size_t c = 0; c < 3; ++c)
+      v.push_back(count(p) > 0 ? float(aovSum[kAovSumsPerPixel * p + first + c] / count(p)) : 0.f);
   return v;
 }
 
-std::vector<float> Film::normal() const {
-  std::vector<float> v;
-  for (size_t p = 0; p < pixels() && hasSurfaceAovs(); ++p)
-    for (size_t c = 0; c < 3; ++c) v.push_back(count(p) > 0 ? float(aovSum[kAovSumsPerPixel * p + 3 + c] / count(p)) : 0.f);
-  return v;
-}
+std::vector<float> Film::albedo() const { return aovMean(0); }
+std::vector<float> Film::normal() const { return aovMean(3); }
 
 std::vector<float> Film::depth() const {
   std::vector<float> v;

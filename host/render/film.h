@@ -59,6 +59,7 @@ struct Film {
   std::vector<double> oddSum;
 
  private:
+  std::vector<float> aovMean(size_t first) const;
   uint64_t passes_ = 0;
 };
 

@@ -20,7 +20,7 @@ PassPool::PassPool(const RenderSettings& s, int workers)
       start_(std::chrono::steady_clock::now()),
       outstanding_(size_t(workers)),
       done_(size_t(workers), 0),
-      film_(s.resume ? *s.resume : Film(s.width, s.height, s.surfaceAovs, s.noise > 0.0)),
+      film_(s.resume ? *s.resume : Film(s.width, s.height, s.surfaceAovs, s.replicates() == 2)),
       progress_(s.progress),
       lastCheckpoint_(std::chrono::steady_clock::now()) {
   // A resumed render goes on from the first pass its film lacks.
@@ -136,7 +136,7 @@ void PassPool::mergeInOrder() {
     pending_.erase(next);
     lock.unlock();
     film_.addPass(samples);
-    const bool check = settings_.noise > 0.0 && nextToMerge_ + 1 >= kNoiseMinPasses;
+    const bool check = settings_.noise > 0.0 && film_.passes() >= kNoiseMinPasses;
     const double estimate = check ? film_.estimatedRelMse() : -1.0;
     lock.lock();
     spare_.push_back(std::move(samples));

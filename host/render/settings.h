@@ -38,6 +38,9 @@ struct RenderSettings {
   // Noise target: stop once the film's estimated relMSE (Film::estimatedRelMse) is at most
   // this, checked after each pass from kNoiseMinPasses on; 0: none.
   double noise = 0.0;
+  // The sampler's independently scrambled sequences (RenderParams::replicates): two under a
+  // noise target, whose difference is its error estimate; else one.
+  unsigned replicates() const { return noise > 0.0 ? 2 : 1; }
   Method method = Method::MIS;
   int maxDepth = 64;     // bounces; Russian roulette does the real work
   // Russian roulette from this bounce on: later than the minimum because roulette adds

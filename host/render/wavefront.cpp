@@ -51,7 +51,7 @@ gpu::RenderParams renderParams(const RenderSettings& s, const Camera& camera, un
   p.max_depth = unsigned(s.maxDepth);
   p.rr_depth = unsigned(s.rrDepth);
   p.light_count = lightCount;
-  p.replicates = s.noise > 0.0 ? 2 : 1;  // a noise target estimates the error from two replicates
+  p.replicates = s.replicates();
   filterTable = filterInverseCdf(s.filter, kFilterTableSize, &p.filter_radius);
   p.filter_table_size = unsigned(filterTable.size());
   return p;
