@@ -19,7 +19,8 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
                          __global const float* light_cdf, __global const int* light_triangle,
                          __global const float* light_pdf_area, __global const float4* normals,
                          __global const float2* uvs, __global const float4* texels,
-                         __global const uint4* texture_info, __global float4* pass_buffer,
+                         __global const uint4* texture_info, __global const float* env_map,
+                         __global float4* pass_buffer,
                          __global float4* aovs FH_PATH_PARAMS) {
   // The work-group's books, added to the device's once at the end (see queue_append_each):
   // samples finished per pass slot, then bounce rays, shadow rays and non-finite samples.
@@ -51,10 +52,10 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
         if (LANE(alive, l)) intersect_slot(nodes, blocks, LANE(p, l), ray_org, ray_dir, hit);
       }
       const ShadeOutcome o = shade_paths(params, p, alive, triangles, triangle_material, materials, light_pdf_area,
-                                         normals, uvs, texels, texture_info, aovs FH_PATH_ARGS);
+                                         normals, uvs, texels, texture_info, env_map, aovs FH_PATH_ARGS);
       if (lanes_any(o.light_sample))  // never for pt, nor without lights
         connect_light(params, &o.request, o.light_sample, nodes, blocks, triangles, triangle_material, materials,
-                      light_cdf, light_triangle, light_pdf_area FH_PATH_ARGS);
+                      light_cdf, light_triangle, light_pdf_area, env_map FH_PATH_ARGS);
       shadow_rays += lanes_count(o.light_sample);
       bounce_rays += lanes_count(o.continues);
       if (lanes_any(o.finished)) {

@@ -1,5 +1,5 @@
 // The shade stage, for every path whose ray was just intersected:
-//   escaped       -> add the environment, finish;
+//   escaped       -> add the environment (the map's with the MIS weight for mis), finish;
 //   emitter hit   -> add Ke where the method counts it (with the MIS weight for mis);
 //   light sample  -> queue a next-event request for shadow_connect (nee, mis);
 //   BSDF sample   -> the next direction, throughput update, Russian roulette, requeue.
@@ -14,6 +14,9 @@
 #include "surface.h"
 #if defined(FH_AOVS)
 #include "aovs.h"
+#endif
+#if defined(FH_ENV_MAP)
+#include "environment.h"
 #endif
 
 #if !defined(FH_METHOD_PT) && !defined(FH_METHOD_NEE) && !defined(FH_METHOD_MIS)
@@ -40,6 +43,24 @@ FH_INLINE lfloat emission_weight(luint depth, lfloat bsdf_pdf, __global const fl
 #endif
 }
 
+#if defined(FH_ENV_MAP)
+// The weight of environment-map radiance found by BSDF sampling (density bsdf_pdf, < 0 for a
+// delta bounce) where light sampling would have drawn the same direction with density
+// light_pdf (0 where it never does: the map not sampled, or a black texel).
+FH_INLINE lfloat environment_weight(luint depth, lfloat bsdf_pdf, lfloat light_pdf) {
+#if defined(FH_METHOD_PT)
+  return (lfloat)(1.0f);
+#else
+  const lmask always = depth == 0 || bsdf_pdf < 0.0f || light_pdf == 0.0f;
+#if defined(FH_METHOD_NEE)
+  return select((lfloat)(0.0f), (lfloat)(1.0f), always);
+#else
+  return select(power_heuristic(bsdf_pdf, light_pdf), (lfloat)(1.0f), always);
+#endif
+#endif
+}
+#endif
+
 // What shading decided for FH_LANES paths: which go on to another bounce, which asked for
 // a light sample (described by `request`), which are finished.
 typedef struct {
@@ -54,7 +75,8 @@ FH_INLINE ShadeOutcome shade_paths(RenderParams params, luint p, lmask active, _
                                    __global const int* triangle_material, __global const GpuMaterial* materials,
                                    __global const float* light_pdf_area, __global const float4* normals,
                                    __global const float2* uvs, __global const float4* texels,
-                                   __global const uint4* texture_info, __global float4* aovs FH_PATH_PARAMS) {
+                                   __global const uint4* texture_info, __global const float* env_map,
+                                   __global float4* aovs FH_PATH_PARAMS) {
   ShadeOutcome o;
   o.continues = o.light_sample = lanes_mask(false);
   // What a light-sample request needs (zero where none is made).
@@ -72,6 +94,14 @@ FH_INLINE ShadeOutcome shade_paths(RenderParams params, luint p, lmask active, _
     const lint hit_triangle = las_int(gather_w(hit, p));
     const lmask escaped = active && hit_triangle < 0, hits = active && hit_triangle >= 0;
     gathered = v3_select(escaped, v3_add(gathered, v3_mul(beta_in, v3_uniform(vload3(0, params.env)))), gathered);
+#if defined(FH_ENV_MAP)
+    if (lanes_any(escaped)) {
+      lfloat env_pdf;
+      const lvec3 le = environment_lookup(params, env_map, gather_xyz(ray_dir, p), &env_pdf);
+      const lfloat weight = environment_weight(bounce, gather_float(ray_pdf, p), params.env_pick * env_pdf);
+      gathered = v3_select(escaped, v3_add(gathered, v3_scale(v3_mul(beta_in, le), weight)), gathered);
+    }
+#endif
 #if defined(FH_AOVS)
     const luint aov = aov_entry(p, params.pixel_count, sample_id, local_pass);
     record_escaped_aovs(aov, escaped && bounce == 0, aovs);
@@ -117,7 +147,8 @@ FH_INLINE ShadeOutcome shade_paths(RenderParams params, luint p, lmask active, _
                           aovs);
   #endif
   #if !defined(FH_METHOD_PT)
-      o.light_sample = may_bounce && params.light_count > 0 && bsdf_has_smooth_lobe(&bsdf);
+      o.light_sample =
+          may_bounce && (params.light_count > 0 || params.env_pick > 0.0f) && bsdf_has_smooth_lobe(&bsdf);
       r->at.position = s.position;
       r->at.magnitude = s.magnitude;
       r->at.normal = v3_select(front, s.normal, v3_neg(s.normal));
@@ -167,7 +198,8 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
                     __global const float4* triangles, __global const int* triangle_material,
                     __global const GpuMaterial* materials, __global const float* light_pdf_area,
                     __global const float4* normals, __global const float2* uvs, __global const float4* texels,
-                    __global const uint4* texture_info, __global float4* aovs FH_PATH_PARAMS FH_SHADOW_PARAMS) {
+                    __global const uint4* texture_info, __global const float* env_map,
+                    __global float4* aovs FH_PATH_PARAMS FH_SHADOW_PARAMS) {
   volatile __local uint scratch[2 * 3];
   const luint position = lane_positions(get_global_id(0) * FH_LANES);
   const lmask active = position < counters->ray_length[parity];
@@ -176,7 +208,7 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
   const luint p =
       lanes_any(active) ? gather_uint(ray_queue, select((luint)(LANE(position, 0)), position, active)) : (luint)(0);
   const ShadeOutcome o = shade_paths(params, p, active, triangles, triangle_material, materials, light_pdf_area,
-                                     normals, uvs, texels, texture_info, aovs FH_PATH_ARGS);
+                                     normals, uvs, texels, texture_info, env_map, aovs FH_PATH_ARGS);
 
   // Continuing paths to the next ray queue, light-sample requests to shadow_connect's,
   // finished paths to accumulate's.

@@ -70,7 +70,7 @@ typedef struct {
 // What every path-tracing stage needs to know about the render.
 typedef struct {
   CameraParams camera;
-  float env[4];           // constant environment radiance for escaped rays
+  float env[4];           // constant environment radiance for escaped rays (--env)
   uint seed;
   uint pixel_count;       // width * height
   uint max_depth;         // bounces
@@ -79,6 +79,10 @@ typedef struct {
   uint filter_table_size; // entries of the pixel filter's inverse CDF
   float filter_radius;
   uint replicates;        // 1, or 2: even and odd passes are independently scrambled sequences
+  // The environment map (FH_ENV_MAP, kernels/environment.h): its size, the u it is turned
+  // by, and the probability that light sampling picks it rather than a triangle (0: never).
+  uint env_width, env_height;
+  float env_u_shift, env_pick;
 } RenderParams;
 
 // The wavefront's queue lengths and books, one struct in one device buffer. The device

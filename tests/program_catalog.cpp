@@ -17,6 +17,13 @@ std::vector<ProgramSpec> everyProgramVariant() {
         const SceneFeatures features{(bits & 1) != 0, (bits & 2) != 0, (bits & 4) != 0, (bits & 8) != 0};
         programs.push_back(pathTracerProgram(features, method, FH_MAX_PASS_SLOTS, traversal, strategy));
       }
+  // The environment map (FH_ENV_MAP) alone; all() below includes it with every material feature.
+  for (Method method : {Method::PT, Method::NEE, Method::MIS})
+    for (Strategy strategy : {Strategy::Scalar, Strategy::Simd8}) {
+      SceneFeatures features;
+      features.environmentMap = true;
+      programs.push_back(pathTracerProgram(features, method, FH_MAX_PASS_SLOTS, traversal, strategy));
+    }
   // The megakernel calls the same stage code: no features and all of them are enough.
   for (Method method : {Method::PT, Method::NEE, Method::MIS})
     for (const SceneFeatures& features : {SceneFeatures{}, SceneFeatures::all()})

@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "device/kernel_sources.h"
+#include "image/image_io.h"
 #include "scene/scene_writer.h"
 #include "program_catalog.h"
 #include "scene_builder.h"
@@ -175,6 +176,17 @@ TEST(OptimisationOff, EveryMethodRendersWhatTheOptimisedBuildRenders) {
 // intersect_block. Every report goes to a log that must stay empty.
 class UnderOclgrind : public ::testing::TestWithParam<const char*> {};
 
+// A small environment map of uneven texels (some black) in `dir`; returns its path.
+std::string writeEnvironmentMap(const std::string& dir) {
+  Image map;
+  map.width = 8;
+  map.height = 4;
+  for (int p = 0; p < 32; ++p) map.rgb.insert(map.rgb.end(), {float(p % 5), float(p % 3), 0.5f * float(p % 2)});
+  const std::string path = dir + "/sky.exr";
+  writeImage(path, map, {});
+  return path;
+}
+
 TEST_P(UnderOclgrind, RunsWithoutReports) {
   ASSERT_TRUE(fs::exists("/usr/bin/oclgrind")) << "oclgrind not found: apt-get install oclgrind";
   const GateScenes scenes;
@@ -184,6 +196,9 @@ TEST_P(UnderOclgrind, RunsWithoutReports) {
     args = "bench " + scenes.features + " --width 8 --height 8 --repeats 1";
   else if (run == "aov")
     args = "render " + scenes.copies + " --aov normal --width 8 --height 8 -o " + scenes.dir + "/aov.exr";
+  else if (run == "env")  // mis with an environment map beside the scene's light
+    args = "render " + scenes.features + " --env-map " + writeEnvironmentMap(scenes.dir) +
+           " --width 8 --height 8 --spp 1 --wavefront 64 -o " + scenes.dir + "/env.exr";
   else
     args = "render " + scenes.features + " --method " + run + " --width 8 --height 8 --spp 1 --wavefront 64 -o " +
            scenes.dir + "/" + run + ".exr";
@@ -198,7 +213,7 @@ TEST_P(UnderOclgrind, RunsWithoutReports) {
   EXPECT_TRUE(reports.empty()) << run << ": Oclgrind reported:\n" << reports.substr(0, 4000);
 }
 
-INSTANTIATE_TEST_SUITE_P(Runs, UnderOclgrind, ::testing::Values("pt", "nee", "mis", "aov", "bench"),
+INSTANTIATE_TEST_SUITE_P(Runs, UnderOclgrind, ::testing::Values("pt", "nee", "mis", "aov", "bench", "env"),
                          [](const ::testing::TestParamInfo<const char*>& p) { return std::string(p.param); });
 
 }  // namespace

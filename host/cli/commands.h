@@ -19,6 +19,8 @@ struct RenderOptions {
   double seconds = 0.0;
   double noise = 0.0;  // --noise: the estimated relMSE to stop at; 0: none
   std::string method = "mis", filter = "box", env, statsFile, strategy = "auto";
+  std::string envMap;  // --env-map FILE (.exr, .hdr)
+  std::optional<float> envRotate, envScale;
   int maxDepth = RenderSettings{}.maxDepth;
   int rrDepth = RenderSettings{}.rrDepth;
   std::optional<size_t> wavefront;  // unset: chosen for each device

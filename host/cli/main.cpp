@@ -47,6 +47,12 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
                         "is 6 here)")
       ->capture_default_str();
   rendering->add_option("--env", o.env, "Constant environment radiance R,G,B (default black)");
+  rendering->add_option("--env-map", o.envMap,
+                        "HDR environment light: a latitude-longitude .exr or .hdr (+y up; the image's centre "
+                        "along -z, where the default camera looks), importance-sampled like the lights");
+  rendering->add_option("--env-rotate", o.envRotate,
+                        "Turn --env-map about the up axis by DEG (counter-clockwise seen from above)");
+  rendering->add_option("--env-scale", o.envScale, "Multiply --env-map's radiance by S");
   rendering->add_option("--filter", o.filter, "Pixel filter: box, gaussian or blackman-harris")
       ->capture_default_str();
   rendering->add_option("--wavefront", o.wavefront, "Paths in flight (default: chosen for the device)");

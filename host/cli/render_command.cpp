@@ -20,6 +20,7 @@
 #include "render/render.h"
 #include "render/render_aov.h"
 #include "render/wavefront.h"
+#include "scene/environment_map.h"
 
 namespace fh {
 namespace {
@@ -64,6 +65,19 @@ Camera chooseCamera(const RenderOptions& o, const Scene& scene) {
   return camera;
 }
 
+// --env-map with its --env-rotate and --env-scale, read and checked; null without a map.
+std::shared_ptr<const EnvironmentMap> environmentMapFrom(const RenderOptions& o) {
+  if (o.envMap.empty()) {
+    if (o.envRotate || o.envScale) throw Error(std::string(o.envRotate ? "--env-rotate" : "--env-scale") +
+                                               " applies to --env-map, and none is given");
+    return nullptr;
+  }
+  if (!o.env.empty())
+    throw Error("--env (constant radiance) and --env-map: pick one (--env-scale scales the map)");
+  return std::make_shared<const EnvironmentMap>(
+      loadEnvironmentMap(o.envMap, o.envRotate.value_or(0.f), o.envScale.value_or(1.f)));
+}
+
 // Every flag that does not need the scene, checked; 64 spp by default (4 for --aov), or
 // with --time or --noise and no --spp as many as they take (a render numbers its samples in
 // 32 bits, so at most that many).
@@ -74,6 +88,7 @@ RenderSettings settingsFrom(const RenderOptions& o) {
   s.filter = parseFilter(o.filter);
   if (!o.env.empty()) s.env = parseVec3Flag("--env", o.env);
   if (s.env[0] < 0 || s.env[1] < 0 || s.env[2] < 0) throw Error("--env '" + o.env + "': radiance cannot be negative");
+  s.envMap = environmentMapFrom(o);
   if (o.width <= 0 || o.height <= 0) throw Error("--width/--height must be positive");
   // Pixels are indexed in 32 bits on the device, with room for several pass buffers.
   if (uint64_t(o.width) * uint64_t(o.height) > (uint64_t(1) << 28))
@@ -195,6 +210,11 @@ std::map<std::string, std::string> imageMetadata(const RenderOptions& o, const S
       {"device", r.stats.contributors()}, {"seed", std::to_string(o.seed)},     {"seconds", formatSeconds(seconds)},
       {"filter", o.filter},              {"max_depth", std::to_string(o.maxDepth)}};
   if (!o.aovs.empty()) metadata["aovs"] = o.aovs;
+  if (!o.envMap.empty()) {
+    metadata["env_map"] = o.envMap;
+    metadata["env_rotate"] = formatSeconds(o.envRotate.value_or(0.f));
+    metadata["env_scale"] = formatScientific(o.envScale.value_or(1.f));
+  }
   if (o.aov.empty()) metadata["estimated_relmse"] = formatScientific(estimatedRelMse);
   return metadata;
 }
@@ -202,7 +222,8 @@ std::map<std::string, std::string> imageMetadata(const RenderOptions& o, const S
 void printSummary(const RenderOptions& o, const RenderSettings& settings, const Scene& scene, const RenderResult& r,
                   const std::string& method, double spp, double seconds, double noise) {
   std::cerr << "fredholm: rendered " << scene.sourcePath << " (" << scene.triangleCount() << " triangles, "
-            << scene.lights.size() << " emissive; " << (o.allFeatures ? "all features" : sceneFeatures(scene).describe())
+            << scene.lights.size() << " emissive; "
+            << (o.allFeatures ? "all features" : featuresFor(scene, settings).describe())
             << ") with " << method << ", " << o.width << "x" << o.height << ", " << spp << " spp on "
             << r.stats.contributors() << " in " << formatSeconds(seconds) << " s\n";
   if (settings.noise > 0) {

@@ -39,7 +39,7 @@ FH_LAYOUT(GpuMaterial, tf, 48);
 FH_LAYOUT(GpuMaterial, illum, 64);
 FH_LAYOUT(GpuMaterial, texture, 68);
 
-static_assert(sizeof(RenderParams) == 128, "RenderParams");
+static_assert(sizeof(RenderParams) == 144, "RenderParams");
 FH_LAYOUT(RenderParams, camera, 0);
 FH_LAYOUT(RenderParams, env, 80);
 FH_LAYOUT(RenderParams, seed, 96);
@@ -50,6 +50,10 @@ FH_LAYOUT(RenderParams, light_count, 112);
 FH_LAYOUT(RenderParams, filter_table_size, 116);
 FH_LAYOUT(RenderParams, filter_radius, 120);
 FH_LAYOUT(RenderParams, replicates, 124);
+FH_LAYOUT(RenderParams, env_width, 128);
+FH_LAYOUT(RenderParams, env_height, 132);
+FH_LAYOUT(RenderParams, env_u_shift, 136);
+FH_LAYOUT(RenderParams, env_pick, 140);
 
 static_assert(sizeof(WavefrontCounters) == 108, "WavefrontCounters");
 FH_LAYOUT(WavefrontCounters, ray_length, 0);

@@ -10,6 +10,7 @@
 
 #include "base/atomic_file.h"
 #include "base/error.h"
+#include "scene/environment_map.h"
 
 namespace fh {
 namespace {
@@ -63,6 +64,7 @@ std::string renderFingerprint(const Scene& scene, const Camera& camera, const Re
   f.add(camera.eye).add(camera.target).add(camera.up).add(camera.fovYDeg);
   f.add(s.width).add(s.height).add(s.seed).add(s.method).add(s.maxDepth).add(s.rrDepth).add(s.env).add(s.filter);
   f.add(s.replicates()).add(s.surfaceAovs);
+  if (s.envMap) f.add(s.envMap->width).add(s.envMap->height).add(s.envMap->uShift()).add(s.envMap->texels);
   return f.hex();
 }
 

@@ -25,12 +25,21 @@ cl::Buffer upload(DeviceContext& dc, const std::vector<T>& data, const char* wha
 
 }  // namespace
 
-LightTable buildLightTable(const Scene& scene, const Bvh& bvh) {
+LightTable buildLightTable(const Scene& scene, const Bvh& bvh, const EnvironmentMap* environment) {
   std::vector<int> bvhIndexOf(bvh.order.size());
   for (size_t k = 0; k < bvh.order.size(); ++k) bvhIndexOf[bvh.order[k]] = int(k);
   LightTable table;
   table.pdfArea.assign(scene.triangleCount(), 0.f);
-  double total = 0.0;
+  double environmentPower = 0.0;
+  if (environment && environment->luminanceIntegral > 0.0) {
+    Vec3f lo, hi;
+    scene.bounds(lo, hi);
+    const double radius = 0.5 * std::sqrt(double(dot(hi - lo, hi - lo)));
+    environmentPower = 3.14159265358979323846 * radius * radius * environment->luminanceIntegral;
+    // A scene of one point (or none) still receives the map's light.
+    if (!(environmentPower > 0.0) || !std::isfinite(environmentPower)) environmentPower = 1.0;
+  }
+  double total = environmentPower;
   std::vector<double> power;
   for (const Light& l : scene.lights) {
     const double p = luminance(l.power);
@@ -39,7 +48,8 @@ LightTable buildLightTable(const Scene& scene, const Bvh& bvh) {
     table.triangle.push_back(bvhIndexOf[l.triangle]);
     total += p;
   }
-  double running = 0.0;
+  table.environmentPick = total > 0.0 ? float(environmentPower / total) : 0.f;
+  double running = environmentPower;
   size_t i = 0;
   for (const Light& l : scene.lights) {
     if (!(luminance(l.power) > 0.f)) continue;
@@ -78,13 +88,14 @@ std::string SceneFeatures::buildOptions() const {
   if (glass) o += " -DFH_GLASS";
   if (textures) o += " -DFH_TEXTURES";
   if (shadingNormals) o += " -DFH_SHADING_NORMALS";
+  if (environmentMap) o += " -DFH_ENV_MAP";
   return o;
 }
 
 std::string SceneFeatures::describe() const {
   std::string d;
   for (const auto& [on, name] : {std::pair{glossy, "glossy"}, {glass, "glass"}, {textures, "textures"},
-                                 {shadingNormals, "shading normals"}})
+                                 {shadingNormals, "shading normals"}, {environmentMap, "environment map"}})
     if (on) d += std::string(d.empty() ? "" : ", ") + name;
   return d.empty() ? "diffuse only" : d;
 }
@@ -131,10 +142,18 @@ TextureData loadTexture(const std::string& path) {
 #endif
 }
 
-DeviceScene::DeviceScene(DeviceContext& dc, const Scene& scene, const Bvh& hostBvh, const SceneFeatures& f)
+DeviceScene::DeviceScene(DeviceContext& dc, const Scene& scene, const Bvh& hostBvh, const SceneFeatures& f,
+                         const EnvironmentMap* env)
     : bvh(dc, hostBvh), features(f) {
-  const LightTable lights = buildLightTable(scene, hostBvh);
+  const LightTable lights = buildLightTable(scene, hostBvh, env);
   lightCount = unsigned(lights.cdf.size());
+  environmentPick = lights.environmentPick;
+  const EnvironmentMap black = makeEnvironmentMap("no environment map", 1, 1, {0.f, 0.f, 0.f}, 0.f, 1.f);
+  const EnvironmentMap& map = env ? *env : black;
+  environmentWidth = map.width;
+  environmentHeight = map.height;
+  environmentUShift = map.uShift();
+  environment = upload(dc, map.packed(), "environment map");
   triangleMaterial = upload(dc, toBvhOrder(scene.triangleMaterial, hostBvh.order), "triangle materials");
   materials = upload(dc, toGpuMaterials(scene), "materials");
   lightCdf = upload(dc, lights.cdf, "light CDF");

@@ -5,21 +5,27 @@
 
 #include "accel/bvh.h"
 #include "accel/ray_caster.h"
+#include "scene/environment_map.h"
 #include "scene/scene.h"
 
 namespace fh {
 
-// Emissive triangles chosen in proportion to power: light i is BVH-order triangle
-// triangle[i], picked with probability cdf[i] - cdf[i-1]. pdfArea[t] is, per BVH-order
-// triangle, P(pick t) / area(t) (zero for non-emitters), the density light sampling
-// gives each point of t, which mis needs when BSDF sampling hits an emitter.
+// Lights chosen in proportion to power: the environment map with probability
+// environmentPick, else emissive triangle i (BVH-order triangle triangle[i]) with
+// probability cdf[i] - cdf[i-1] (cdf[-1] being environmentPick). pdfArea[t] is, per
+// BVH-order triangle, P(pick t) / area(t) (zero for non-emitters), the density light
+// sampling gives each point of t, which mis needs when BSDF sampling hits an emitter.
+// The map's power is that of pbrt's infinite lights: the flux its radiance sends through
+// a disk of the scene's bounding radius, pi r^2 times the luminance integrated over the
+// sphere; a triangle's is pi area Ke (Light::power).
 struct LightTable {
   std::vector<float> cdf;
   std::vector<int> triangle;
   std::vector<float> pdfArea;
+  float environmentPick = 0.f;
 };
 
-LightTable buildLightTable(const Scene& scene, const Bvh& bvh);
+LightTable buildLightTable(const Scene& scene, const Bvh& bvh, const EnvironmentMap* environment = nullptr);
 
 std::vector<gpu::GpuMaterial> toGpuMaterials(const Scene& scene);
 
@@ -30,7 +36,8 @@ struct SceneFeatures {
   bool glass = false;           // dielectrics (illum 4/6/7/9)
   bool textures = false;        // map_Kd textures (with UVs)
   bool shadingNormals = false;  // vertex normals in the OBJ
-  static SceneFeatures all() { return {true, true, true, true}; }
+  bool environmentMap = false;  // --env-map (a render setting rather than the OBJ's)
+  static SceneFeatures all() { return {true, true, true, true, true}; }
   std::string buildOptions() const;
   std::string describe() const;
 };
@@ -47,12 +54,21 @@ TextureData loadTexture(const std::string& path);
 
 class DeviceScene {
  public:
-  // `features` may include more than the scene uses (to measure specialization).
-  DeviceScene(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const SceneFeatures& features);
+  // `features` may include more than the scene uses (to measure specialization);
+  // `environment` may be null (no map).
+  DeviceScene(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const SceneFeatures& features,
+              const EnvironmentMap* environment = nullptr);
+
+  // Whether next-event estimation has anything to sample.
+  bool hasLights() const { return lightCount > 0 || environmentPick > 0.f; }
 
   DeviceBvh bvh;
   SceneFeatures features;
   unsigned lightCount = 0;
+  float environmentPick = 0.f;
+  int environmentWidth = 1, environmentHeight = 1;
+  float environmentUShift = 0.f;
+  cl::Buffer environment;  // kernels/environment.h's layout; a black 1x1 map when there is none
   cl::Buffer triangleMaterial, materials, lightCdf, lightTriangle, lightPdfArea;
   cl::Buffer normals, uvs, texels, textureInfo;  // one-element placeholders when unused
   std::vector<std::string> warnings;             // textures that could not be read

@@ -10,6 +10,7 @@
 
 namespace fh {
 
+struct EnvironmentMap;
 struct Film;
 
 enum class Method { PT, NEE, MIS };
@@ -47,7 +48,9 @@ struct RenderSettings {
   // variance that, in closed scenes, costs more than the extra bounces (bench/RESULTS.md).
   int rrDepth = 6;
   unsigned seed = 1;
-  std::array<float, 3> env{0.f, 0.f, 0.f};
+  std::array<float, 3> env{0.f, 0.f, 0.f};  // --env: constant radiance, found by BSDF sampling only
+  // --env-map: an HDR map lighting the scene, sampled like the triangle lights; null: none.
+  std::shared_ptr<const EnvironmentMap> envMap;
   PixelFilter filter = PixelFilter::Box;
   size_t wavefront = 0;  // paths in flight per device; 0: chosen for each device
   bool progress = false;

@@ -41,7 +41,7 @@ class ArgumentList {
   cl_uint next_ = 0;
 };
 
-gpu::RenderParams renderParams(const RenderSettings& s, const Camera& camera, unsigned lightCount,
+gpu::RenderParams renderParams(const RenderSettings& s, const Camera& camera, const DeviceScene& scene,
                                std::vector<float>& filterTable) {
   gpu::RenderParams p{};
   p.camera = makeCameraParams(camera, s.width, s.height);
@@ -50,14 +50,24 @@ gpu::RenderParams renderParams(const RenderSettings& s, const Camera& camera, un
   p.pixel_count = unsigned(s.width) * unsigned(s.height);
   p.max_depth = unsigned(s.maxDepth);
   p.rr_depth = unsigned(s.rrDepth);
-  p.light_count = lightCount;
+  p.light_count = scene.lightCount;
   p.replicates = s.replicates();
+  p.env_width = unsigned(scene.environmentWidth);
+  p.env_height = unsigned(scene.environmentHeight);
+  p.env_u_shift = scene.environmentUShift;
+  p.env_pick = scene.environmentPick;
   filterTable = filterInverseCdf(s.filter, kFilterTableSize, &p.filter_radius);
   p.filter_table_size = unsigned(filterTable.size());
   return p;
 }
 
 }  // namespace
+
+SceneFeatures featuresFor(const Scene& scene, const RenderSettings& s) {
+  SceneFeatures f = s.allFeatures ? SceneFeatures::all() : sceneFeatures(scene);
+  f.environmentMap = f.environmentMap || s.envMap;
+  return f;
+}
 
 ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsigned passSlots,
                               const std::string& traversalOptions, Strategy strategy, bool surfaceAovs) {
@@ -98,14 +108,14 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
     : dc_(dc),
       method_(s.method),
       strategy_(strategyFor(dc.info, s.strategy)),
-      scene_(dc, scene, bvh, s.allFeatures ? SceneFeatures::all() : sceneFeatures(scene)),
+      scene_(dc, scene, bvh, featuresFor(scene, s), s.envMap.get()),
       pixels_(unsigned(s.width) * unsigned(s.height)),
       surfaceAovs_(s.surfaceAovs) {
   // No more paths than the passes in flight can ever hold.
   const size_t most = roundUp(size_t(FH_MAX_PASS_SLOTS) * pixels_, kLocalSize);
   wavefront_ = std::min(s.wavefront ? s.wavefront : defaultWavefront(dc.info, pixels_), most);
   std::vector<float> filterTable;
-  params_ = renderParams(s, camera, scene_.lightCount, filterTable);
+  params_ = renderParams(s, camera, scene_, filterTable);
   // Enough passes in flight that the wavefront stays full while a pass's longest paths
   // finish: pass buffers cost a frame each, so only as many as the wavefront needs.
   passSlots_ = unsigned(std::min<size_t>(FH_MAX_PASS_SLOTS, 2 + (2 * wavefront_ + pixels_ - 1) / pixels_));
@@ -173,7 +183,7 @@ void WavefrontPipeline::bindArguments(unsigned parity) {
         << params_ << queues_.counters << parity << queues_.freeSlots << filterTable_ << passTableBuffer_
         << sc.bvh.nodes() << sc.bvh.blocks() << sc.bvh.triangles() << sc.triangleMaterial << sc.materials
         << sc.lightCdf << sc.lightTriangle << sc.lightPdfArea << sc.normals << sc.uvs << sc.texels << sc.textureInfo
-        << passBuffers_ << aovBuffers_ << paths_;
+        << sc.environment << passBuffers_ << aovBuffers_ << paths_;
     return;
   }
   args(Stage::Generate) << params_ << queues_.counters << queues_.freeSlots << rays << filterTable_
@@ -182,10 +192,11 @@ void WavefrontPipeline::bindArguments(unsigned parity) {
                          << paths_.ray_org << paths_.ray_dir << paths_.hit;
   args(Stage::Shade) << params_ << rays << nextRays << queues_.finished << queues_.counters << parity
                      << sc.bvh.triangles() << sc.triangleMaterial << sc.materials << sc.lightPdfArea << sc.normals
-                     << sc.uvs << sc.texels << sc.textureInfo << aovBuffers_ << paths_ << shadowRequests_;
+                     << sc.uvs << sc.texels << sc.textureInfo << sc.environment << aovBuffers_ << paths_
+                     << shadowRequests_;
   args(Stage::ShadowConnect) << params_ << queues_.counters << sc.bvh.nodes() << sc.bvh.blocks()
                              << sc.bvh.triangles() << sc.triangleMaterial << sc.materials << sc.lightCdf
-                             << sc.lightTriangle << sc.lightPdfArea << paths_ << shadowRequests_;
+                             << sc.lightTriangle << sc.lightPdfArea << sc.environment << paths_ << shadowRequests_;
   args(Stage::Accumulate) << queues_.finished << queues_.counters << queues_.freeSlots << pixels_ << passBuffers_
                           << paths_;
 }
@@ -200,7 +211,7 @@ void WavefrontPipeline::enqueueIteration() {
     generate();
     intersect();
     shade();
-    if (method_ != Method::PT && scene_.lightCount > 0) shadowConnect();
+    if (method_ != Method::PT && scene_.hasLights()) shadowConnect();
     accumulate();
   }
   finishIteration();

@@ -49,6 +49,10 @@ struct SlotQueues {
 ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsigned passSlots,
                               const std::string& traversalOptions, Strategy strategy, bool surfaceAovs = false);
 
+// The features a render's kernels are compiled with: the scene's (or all of them with
+// --all-features), and the environment map if the render has one.
+SceneFeatures featuresFor(const Scene& scene, const RenderSettings& s);
+
 // The strategy a device runs: the one asked for, or for Auto, eight lanes on a CPU and
 // one path per work-item elsewhere.
 Strategy strategyFor(const DeviceInfo& device, Strategy asked);

@@ -1,0 +1,98 @@
+// The HDR environment light (FH_ENV_MAP): radiance from a latitude-longitude map for rays
+// that leave the scene, and directions drawn from the map for next-event estimation, in
+// proportion to the map's luminance per solid angle (a piecewise-constant 2D distribution:
+// a row by the marginal CDF, then a column by that row's CDF). Both sides compute one
+// density for a direction (environment_pdf), so mis weighs them consistently.
+// Conventions (host/scene/environment_map.h): +y up, row 0 at theta = 0, u = 0.5 along -z,
+// u growing towards +x; params.env_u_shift turns the map about +y. Lane-wise (lanes.h).
+//
+// The env_map buffer holds, for a width x height map: per texel four floats (rgb radiance,
+// density per unit uv area), then each row's CDF over its columns, then the CDF over rows.
+#ifndef FH_ENVIRONMENT_H
+#define FH_ENVIRONMENT_H
+
+#include "lanes.h"
+#include "sampling.h"
+
+// Texels are picked by u, v on [0,1)^2; a direction's solid angle is 2 pi^2 sin(theta) du dv.
+#define FH_ENV_SOLID_ANGLE_PER_UV (2.0f * M_PI_F * M_PI_F)
+
+// Texel i's radiance, and its density per unit uv area in *density.
+FH_INLINE lvec3 environment_texel(__global const float* env_map, luint i, lfloat* density) {
+  lvec3 radiance;
+  FH_FOR_LANES(l) {
+    const float4 t = vload4(LANE(i, l), env_map);
+    LANE(radiance.x, l) = t.x;
+    LANE(radiance.y, l) = t.y;
+    LANE(radiance.z, l) = t.z;
+    LANE(*density, l) = t.w;
+  }
+  return radiance;
+}
+
+// The density per solid angle of a texel's density per uv area, at sin(theta).
+FH_INLINE lfloat environment_pdf(lfloat density, lfloat sin_theta) {
+  return select((lfloat)(0.0f), density / (FH_ENV_SOLID_ANGLE_PER_UV * sin_theta), sin_theta > 0.0f);
+}
+
+// The radiance arriving from direction d (unit), and in *pdf the density per solid angle
+// with which environment_sample draws d (before the light pick's probability).
+FH_INLINE lvec3 environment_lookup(RenderParams params, __global const float* env_map, lvec3 d, lfloat* pdf) {
+  const lfloat v = acos(clamp(d.y, -1.0f, 1.0f)) * M_1_PI_F;
+  const lfloat u_unwrapped = atan2(d.x, -d.z) * (0.5f * M_1_PI_F) + 0.5f + params.env_u_shift;
+  const lfloat u = u_unwrapped - floor(u_unwrapped);
+  const luint column = min(lconvert_uint(u * (float)(params.env_width)), (luint)(params.env_width - 1));
+  const luint row = min(lconvert_uint(v * (float)(params.env_height)), (luint)(params.env_height - 1));
+  lfloat density;
+  const lvec3 radiance = environment_texel(env_map, row * params.env_width + column, &density);
+  *pdf = environment_pdf(density, sqrt(d.x * d.x + d.z * d.z));
+  return radiance;
+}
+
+// The first entry of cdf[0 .. count-1] above u, and in *fraction where u lies between the
+// entry before it and that one (in [0, 1)).
+FH_INLINE uint environment_search(__global const float* cdf, uint count, float u, float* fraction) {
+  uint lo = 0, hi = count - 1;
+  while (lo < hi) {
+    const uint mid = (lo + hi) / 2;
+    if (cdf[mid] > u) hi = mid;
+    else lo = mid + 1;
+  }
+  const float below = lo > 0 ? cdf[lo - 1] : 0.0f, width = cdf[lo] - below;
+  *fraction = width > 0.0f ? clamp((u - below) / width, 0.0f, 0x1.fffffep-1f) : 0.5f;
+  return lo;
+}
+
+// A direction drawn from the map, the radiance arriving from it and its density per solid
+// angle (pdf 0: no sample, at a pole).
+typedef struct {
+  lvec3 wi, radiance;
+  lfloat pdf;
+} EnvironmentSample;
+
+FH_INLINE EnvironmentSample environment_sample(RenderParams params, __global const float* env_map, lfloat u1,
+                                               lfloat u2) {
+  const uint width = params.env_width, height = params.env_height;
+  __global const float* row_cdf = env_map + 4 * width * height;
+  __global const float* marginal_cdf = row_cdf + width * height;
+  luint texel;
+  lfloat u, v;
+  FH_FOR_LANES(l) {
+    float row_fraction, column_fraction;
+    const uint row = environment_search(marginal_cdf, height, LANE(u1, l), &row_fraction);
+    const uint column = environment_search(row_cdf + row * width, width, LANE(u2, l), &column_fraction);
+    LANE(texel, l) = row * width + column;
+    LANE(v, l) = ((float)(row) + row_fraction) / (float)(height);
+    LANE(u, l) = ((float)(column) + column_fraction) / (float)(width);
+  }
+  EnvironmentSample s;
+  lfloat density;
+  s.radiance = environment_texel(env_map, texel, &density);
+  const lvec2 theta = sincos_reduced(M_PI_F * v);  // (sin, cos)
+  const lvec2 phi = sincos_reduced(2.0f * M_PI_F * (u - 0.5f - params.env_u_shift));
+  s.wi = v3(theta.x * phi.x, theta.y, -theta.x * phi.y);
+  s.pdf = environment_pdf(density, theta.x);
+  return s;
+}
+
+#endif
