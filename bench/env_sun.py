@@ -1,11 +1,11 @@
 #!/usr/bin/python3
 """Error against time under an HDR environment map with a small, bright sun: pt, nee and mis.
 
-  bench/env_sun.py [--out bench/out/env-sun] [--width 128] [--height 96] [--max-spp 256] [--ref-spp 4096]
+  bench/env_sun.py [--out bench/out/env-sun] [--width 192] [--height 144] [--max-spp 256] [--ref-spp 4096]
 
 Writes, into OUT:
   - sun-sky.exr: a 512x256 latitude-longitude map, a sky of radiance 0.4-1.0 (brighter
-    towards the zenith), a dim ground, and a sun 0.5 degrees in radius at 40 degrees
+    towards the zenith), a dim ground, and a sun 1 degree in radius at 40 degrees
     elevation whose radiance gives it most of the light on a horizontal plane;
   - sun-blob.obj: the generated test blob (build/test-scenes/blob) standing on a ground square,
     with a camera that sees the blob's shadow.
@@ -26,7 +26,7 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BLOB = os.path.join(ROOT, "build", "test-scenes", "blob", "blob.obj")
 
-SUN_ELEVATION_DEG, SUN_AZIMUTH_DEG, SUN_RADIUS_DEG = 40.0, 60.0, 0.5
+SUN_ELEVATION_DEG, SUN_AZIMUTH_DEG, SUN_RADIUS_DEG = 40.0, 60.0, 1.0
 
 
 def direction(u, v):
@@ -85,8 +85,8 @@ def write_scene(folder):
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", default=os.path.join(ROOT, "bench", "out", "env-sun"))
-    p.add_argument("--width", type=int, default=128)
-    p.add_argument("--height", type=int, default=96)
+    p.add_argument("--width", type=int, default=192)
+    p.add_argument("--height", type=int, default=144)
     p.add_argument("--max-spp", type=int, default=256)
     p.add_argument("--ref-spp", type=int, default=4096)
     args = p.parse_args()
