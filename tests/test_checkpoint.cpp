@@ -1,14 +1,20 @@
 // Checkpoints (--checkpoint, --resume): a render killed with SIGKILL after any number of
 // passes and resumed gives the image an uninterrupted render gives, to the bit; Ctrl-C
 // leaves a checkpoint too; a checkpoint is refused by a render of other settings and when
-// it is damaged, with a one-line error.
+// it is damaged, with a one-line error. Chunks (--passes A:B --film FILE, fredholm merge):
+// merged, they are the bits of one render however the passes were split and rendered.
 #include <gtest/gtest.h>
+#include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <string>
+#include <vector>
 
 #include "image/image_io.h"
+#include "render/film.h"
 #include "test_support.h"
 
 namespace fh {
@@ -77,13 +83,13 @@ TEST(Checkpoint, OtherSettingsOrADamagedFileAreRefused) {
   std::string header;
   std::getline(std::ifstream(ckpt), header);
   const std::string fingerprint = header.substr(header.find(' ') + 1, 16);
-  test::writeFile(dir + "/huge.fhc", "fredholm-checkpoint-1 " + fingerprint + " 16384 16384 3 0 0\n0123");
+  test::writeFile(dir + "/huge.fhc", "fredholm-film-2 " + fingerprint + " 16384 16384 0 3 0 0\n0123");
   const auto huge = test::runFredholm(kRender + " --resume " + dir + "/huge.fhc -o " + dir + "/e.exr");
   EXPECT_EQ(huge.exitCode, 1);
   test::writeFile(dir + "/junk.fhc", "not a checkpoint\n");
   const auto junk = test::runFredholm(kRender + " --resume " + dir + "/junk.fhc -o " + dir + "/d.exr");
   EXPECT_EQ(junk.exitCode, 1);
-  EXPECT_NE(junk.output.find("not a fredholm checkpoint"), std::string::npos) << junk.output;
+  EXPECT_NE(junk.output.find("not a fredholm film or checkpoint"), std::string::npos) << junk.output;
   for (const char* f : {"/b.exr", "/c.exr", "/d.exr"}) EXPECT_FALSE(std::filesystem::exists(dir + f)) << f;
 }
 
@@ -102,6 +108,114 @@ TEST(Checkpoint, CtrlCLeavesACheckpointToResumeFrom) {
   ASSERT_EQ(resumed.exitCode, 0) << resumed.output;
   ASSERT_EQ(test::runFredholm(render + " -o " + dir + "/straight.exr").exitCode, 0);
   EXPECT_TRUE(readImage(dir + "/resumed.exr").rgb == readImage(dir + "/straight.exr").rgb);
+}
+
+// Every channel of an EXR (the image and its layers), as stored.
+std::vector<float> exrChannels(const std::string& path, std::vector<std::string>* names = nullptr) {
+  auto in = OIIO::ImageInput::open(path);
+  EXPECT_TRUE(in) << path;
+  if (!in) return {};
+  const OIIO::ImageSpec& spec = in->spec();
+  std::vector<float> values(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+  in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, values.data());
+  if (names) *names = spec.channelnames;
+  return values;
+}
+
+// Passes of samples over eleven decades (more than double precision adds exactly from
+// float samples), added one by one and as chunks merged in another
+// order: the film's sums (and so its image) are the same bits.
+TEST(Chunks, FilmSumsDoNotDependOnHowPassesAreSplit) {
+  constexpr int kW = 8, kH = 4, kPasses = 40;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> exponent(-6.f, 5.f);
+  std::vector<std::vector<float>> passes(kPasses);
+  for (auto& pass : passes)
+    for (int p = 0; p < kW * kH; ++p)
+      pass.insert(pass.end(), {std::pow(10.f, exponent(rng)), std::pow(10.f, exponent(rng)), 1e-7f * float(p), 1.f});
+  Film whole(kW, kH);
+  for (const auto& pass : passes) whole.addPass(pass);
+  for (const std::vector<int>& cuts : std::vector<std::vector<int>>{{0, 13, 40}, {0, 1, 2, 39, 40}, {0, 20, 27, 40}}) {
+    std::vector<Film> chunks;
+    for (size_t c = 0; c + 1 < cuts.size(); ++c) {
+      chunks.emplace_back(kW, kH, false, false, uint64_t(cuts[c]));
+      for (int p = cuts[c]; p < cuts[c + 1]; ++p) chunks.back().addPass(passes[size_t(p)]);
+    }
+    Film merged = chunks.back();  // the last first: any order
+    for (size_t c = 0; c + 1 < chunks.size(); ++c) merged.merge(chunks[c]);
+    EXPECT_EQ(merged.passes(), uint64_t(kPasses));
+    EXPECT_EQ(merged.firstPass(), 0u);
+    EXPECT_TRUE(merged.sum == whole.sum) << "split at " << cuts[1];
+    EXPECT_TRUE(merged.image().rgb == whole.image().rgb) << "split at " << cuts[1];
+  }
+}
+
+// Chunks of passes rendered apart, on one device or two, by other strategies, merged in any
+// order with their layers: the same EXR channels, to the bit, as one render.
+TEST(Chunks, MergedChunksAreTheBitsOfOneRender) {
+  const std::string dir = test::tempDir("chunks");
+  const std::string render = "render --width 24 --height 16 --seed 9 --method mis --aovs albedo,depth,spp ";
+  const auto one = test::runFredholm(render + "--spp 12 -o " + dir + "/one.exr");
+  ASSERT_EQ(one.exitCode, 0) << one.output;
+  struct Chunk {
+    std::string passes, flags, env;
+  };
+  const std::vector<Chunk> chunks = {{"0:3", "", ""},
+                                     {"3:7", "--device all", "POCL_DEVICES='pthread basic'"},
+                                     {"7:12", "--strategy scalar --wavefront 256", ""}};
+  std::string films;
+  for (const Chunk& c : chunks) {
+    const std::string film = dir + "/part-" + c.passes.substr(0, c.passes.find(':')) + ".film";
+    const auto r = test::runFredholm(render + "--passes " + c.passes + " --film " + film + " " + c.flags, c.env);
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("passes " + c.passes), std::string::npos) << r.output;
+    films = film + " " + films;  // merged in reverse
+  }
+  const auto merged = test::runFredholm("merge " + films + "--aovs albedo,depth,spp -o " + dir + "/merged.exr");
+  ASSERT_EQ(merged.exitCode, 0) << merged.output;
+  std::vector<std::string> names, oneNames;
+  const std::vector<float> a = exrChannels(dir + "/merged.exr", &names), b = exrChannels(dir + "/one.exr", &oneNames);
+  EXPECT_EQ(names, oneNames);
+  EXPECT_EQ(names.size(), 8u);  // R G B, albedo.R/G/B, depth.Z, spp.Y
+  EXPECT_TRUE(a == b) << "the merged chunks differ from one render";
+}
+
+// Chunks that overlap, come from another render or leave passes out; flags a chunk does not
+// go with; a chunk offered as a checkpoint.
+TEST(Chunks, OverlapsOtherRendersGapsAndBadFlagsAreCaught) {
+  const std::string dir = test::tempDir("chunk-errors");
+  const std::string render = "render --width 8 --height 8 --seed 2 ";
+  for (const char* passes : {"0:4", "2:6", "6:9"})
+    ASSERT_EQ(test::runFredholm(render + "--passes " + passes + " --film " + dir + "/p" + passes[0] + ".film").exitCode,
+              0);
+  ASSERT_EQ(test::runFredholm("render --width 8 --height 8 --seed 3 --passes 4:6 --film " + dir + "/other.film").exitCode,
+            0);
+  struct Case {
+    std::string args, message;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"merge " + dir + "/p0.film " + dir + "/p2.film -o " + dir + "/x.exr", "share passes"},
+           {"merge " + dir + "/p0.film " + dir + "/other.film -o " + dir + "/x.exr", "a chunk of another render"},
+           {"merge " + dir + "/p0.film " + dir + "/missing.film -o " + dir + "/x.exr", "cannot read"},
+           {"merge " + dir + "/p0.film", "--output is required"},
+           {render + "--passes 4:4 --film " + dir + "/e.film", "0 <= A < B"},
+           {render + "--passes -1:4 --film " + dir + "/e.film", "0 <= A < B"},
+           {render + "--passes 0:4", "give --film"},
+           {render + "--passes 0:4 --film " + dir + "/e.film --spp 4", "does not go with --spp"},
+           {render + "--passes 0:4 --film " + dir + "/e.film --noise 1e-2", "does not go with --noise"},
+           {render + "--passes 0:4 --film " + dir + "/e.film --checkpoint " + dir + "/c.fhc", "--checkpoint"},
+           {render + "--passes 0:4 --film " + dir + "/p0.film", "file exists"},
+           {render + "--spp 9 --resume " + dir + "/p6.film -o " + dir + "/x.exr", "a chunk of passes 6:9"}}) {
+    const auto r = test::runFredholm(c.args);
+    EXPECT_NE(r.exitCode, 0) << c.args;
+    EXPECT_NE(r.output.find(c.message), std::string::npos) << c.args << "\n" << r.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.exr"));
+  // A gap is said, and the image holds the passes there are.
+  const auto gap = test::runFredholm("merge " + dir + "/p6.film " + dir + "/p0.film -o " + dir + "/gap.exr");
+  ASSERT_EQ(gap.exitCode, 0) << gap.output;
+  EXPECT_NE(gap.output.find("no part holds passes 4:6"), std::string::npos) << gap.output;
+  EXPECT_NE(gap.output.find("7 passes from 2 parts"), std::string::npos) << gap.output;
 }
 
 }  // namespace

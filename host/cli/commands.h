@@ -31,12 +31,21 @@ struct RenderOptions {
   std::string aov;
   std::string aovs;  // --aovs: layers written beside the image in one EXR
   std::string checkpoint, resume;  // --checkpoint FILE, --resume FILE
+  std::string passes, film;        // --passes A:B (a chunk), --film FILE (the film, for fredholm merge)
   double checkpointEvery = RenderSettings{}.checkpointSeconds;
   std::string device;
 };
 int runRender(RenderOptions o);
 
 int runDevices(const std::string& spec);
+
+// `fredholm merge`: films of chunks of one render (--passes, --film) into its image.
+struct MergeOptions {
+  std::vector<std::string> parts;
+  std::string output, aovs;
+  bool force = false;
+};
+int runMerge(const MergeOptions& o);
 
 struct CompareOptions {
   std::string image, reference;

@@ -83,6 +83,12 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
   rendering->add_option("--resume", o.resume,
                         "Go on from a checkpoint of the same scene and settings (--spp may be raised): the image "
                         "is the one an uninterrupted render gives");
+  rendering->add_option("--passes", o.passes,
+                        "Render only passes A to B-1 of the render (A:B; pass n is every pixel's sample n) into "
+                        "--film, a chunk that fredholm merge combines with the others into the image of all");
+  rendering->add_option("--film", o.film,
+                        "Save the render's film (its sums, passes and fingerprint) to FILE for fredholm merge; "
+                        "with it, an image is written only if -o is given");
   rendering->add_option("--device", o.device,
                         std::string("Devices sharing the render (--aov: one): ") + kDeviceSpec);
   return rendering;
@@ -106,6 +112,17 @@ CLI::App* addBench(CLI::App& app, BenchOptions& o) {
   o.external = makeEmbreeTracer;
 #endif
   return benching;
+}
+
+CLI::App* addMerge(CLI::App& app, MergeOptions& o) {
+  CLI::App* merging = app.add_subcommand(
+      "merge", "Combine the films of chunks of one render (render --passes A:B --film FILE) into its image: the "
+               "same bits as one render of all their passes");
+  merging->add_option("parts", o.parts, "Film files, in any order")->required();
+  merging->add_option("-o,--output", o.output, "Output image (.exr .hdr .pfm .png .jpg)")->required();
+  merging->add_option("--aovs", o.aovs, "Layers beside the image, as for render (the chunks must have recorded them)");
+  merging->add_flag("--force", o.force, "Overwrite an existing output file");
+  return merging;
 }
 
 CLI::App* addCompare(CLI::App& app, CompareOptions& o) {
@@ -150,12 +167,14 @@ int main(int argc, char** argv) {
   CompareOptions compare;
   ReferenceOptions reference;
   ExportOptions exporting;
+  MergeOptions merge;
   CLI::App* devices = addDevices(app, devicesSpec);
   CLI::App* rendering = addRender(app, render);
   CLI::App* benching = addBench(app, bench);
   CLI::App* comparing = addCompare(app, compare);
   CLI::App* referencing = addReference(app, reference);
   CLI::App* exporter = addExport(app, exporting);
+  CLI::App* merging = addMerge(app, merge);
 
   try {
     app.parse(argc, argv);
@@ -171,6 +190,7 @@ int main(int argc, char** argv) {
     if (*referencing) return runReference(reference);
     if (*comparing) return runCompare(compare);
     if (*exporter) return runExport(exporting);
+    if (*merging) return runMerge(merge);
   } catch (const Interrupted& e) {
     std::cerr << "fredholm: interrupted: " << e.what() << "\n";
     return e.exitCode();

@@ -78,6 +78,24 @@ std::shared_ptr<const EnvironmentMap> environmentMapFrom(const RenderOptions& o)
       loadEnvironmentMap(o.envMap, o.envRotate.value_or(0.f), o.envScale.value_or(1.f)));
 }
 
+// --passes A:B: the chunk's first pass and its end (the render's spp), checked against the
+// flags a chunk cannot go with.
+void chunkOf(const RenderOptions& o, RenderSettings& s) {
+  unsigned long long first = 0, end = 0;
+  char colon = 0, rest = 0;
+  std::istringstream in(o.passes);
+  if (!(in >> first >> colon >> end) || colon != ':' || in >> rest || o.passes[0] == '-' ||
+      o.passes.find(":-") != std::string::npos || first >= end || end > 0x7fffffffull)
+    throw Error("--passes '" + o.passes + "': give A:B, passes A to B-1 with 0 <= A < B (e.g. 0:64)");
+  const char* clash = o.spp ? "--spp (the chunk's end is its spp)" : o.noise > 0 ? "--noise" : !o.resume.empty() ? "--resume"
+                      : !o.checkpoint.empty() ? "--checkpoint (the chunk is the unit to rerun)" : !o.aov.empty() ? "--aov"
+                                                                                                   : nullptr;
+  if (clash) throw Error("--passes renders a chunk for fredholm merge and does not go with " + std::string(clash));
+  if (o.film.empty()) throw Error("--passes renders a chunk for fredholm merge: give --film FILE to save it to");
+  s.firstPass = uint32_t(first);
+  s.spp = int(end);
+}
+
 // Every flag that does not need the scene, checked; 64 spp by default (4 for --aov), or
 // with --time or --noise and no --spp as many as they take (a render numbers its samples in
 // 32 bits, so at most that many).
@@ -106,6 +124,7 @@ RenderSettings settingsFrom(const RenderOptions& o) {
   s.spp = o.spp ? *o.spp
                 : (o.seconds > 0 || o.noise > 0 ? int(std::min<uint64_t>(1 << 20, 0xFFFFFFFFull / pixels))
                                  : (o.aov.empty() ? 64 : 4));
+  if (!o.passes.empty()) chunkOf(o, s);
   s.seconds = o.seconds;
   s.noise = o.noise;
   s.maxDepth = o.maxDepth;
@@ -143,33 +162,6 @@ RenderResult renderDebugView(Aov mode, const std::vector<DeviceInfo>& devices, c
   return r;
 }
 
-// The film's image with the --aovs layers, named as compositors and denoisers read them.
-Image imageWithLayers(const Film& film, const std::vector<std::string>& layers) {
-  Image image = film.image();
-  for (const std::string& name : layers) {
-    ImageLayer layer{name, {}, {}};
-    if (name == "albedo") {
-      layer.channels = {"R", "G", "B"};
-      layer.values = film.albedo();
-    } else if (name == "normal") {
-      layer.channels = {"X", "Y", "Z"};
-      layer.values = film.normal();
-    } else if (name == "depth") {
-      layer.channels = {"Z"};
-      layer.values = film.depth();
-    } else if (name == "variance") {
-      layer.channels = {"R", "G", "B"};
-      for (size_t p = 0; p < film.pixels(); ++p)
-        for (double v : film.varianceOfMean(p)) layer.values.push_back(float(v));
-    } else {  // spp
-      layer.channels = {"Y"};
-      for (size_t p = 0; p < film.pixels(); ++p) layer.values.push_back(float(film.count(p)));
-    }
-    image.layers.push_back(std::move(layer));
-  }
-  return image;
-}
-
 void reportDevices(const RenderResult& r) {
   for (const auto& w : r.warnings) std::cerr << "fredholm: warning: " << w << "\n";
   for (const auto& d : r.stats.devices)
@@ -187,9 +179,14 @@ std::vector<std::string> checkOutputs(RenderOptions& o, RenderSettings& settings
   if (!o.aov.empty() && !layers.empty()) throw Error("--aov (a debug view) and --aovs (layers beside the image): pick one");
   for (const auto& layer : layers) settings.surfaceAovs |= isSurfaceAov(layer);
   // An explicit -o is never overwritten without --force; the default name steps aside.
-  if (o.output.empty()) o.output = firstFreeName(layers.empty() ? "fredholm.png" : "fredholm.exr");
-  checkOutputPath(o.output, o.force);
-  if (!layers.empty() && extensionOf(o.output) != ".exr")
+  // With --film the film is the output, and an image is written only where -o asks.
+  if (o.output.empty() && o.film.empty()) o.output = firstFreeName(layers.empty() ? "fredholm.png" : "fredholm.exr");
+  if (!o.film.empty()) {
+    if (!o.aov.empty()) throw Error("--film saves a render's passes; --aov renders none");
+    checkOutputFile(o.film, o.force, "--film");
+  }
+  if (!o.output.empty()) checkOutputPath(o.output, o.force);
+  if (!layers.empty() && !o.output.empty() && extensionOf(o.output) != ".exr")
     throw Error("--aovs: layers are written into one EXR; -o '" + o.output + "' is not an .exr file");
   if (!o.statsFile.empty()) checkOutputFile(o.statsFile, o.force, "--stats");
   // The checkpoint a render resumes from is its own to overwrite.
@@ -197,8 +194,25 @@ std::vector<std::string> checkOutputs(RenderOptions& o, RenderSettings& settings
   if (!std::isfinite(o.checkpointEvery) || o.checkpointEvery < 0)
     throw Error("--checkpoint-every must be a finite number of seconds, 0 or more");
   settings.checkpointPath = o.checkpoint;
+  settings.filmPath = o.film;
   settings.checkpointSeconds = o.checkpointEvery;
   return layers;
+}
+
+// Writes the image where -o names one and the film for --film; returns what was written.
+std::string writeOutputs(const RenderOptions& o, const RenderSettings& s, const Film& film, const Image& image,
+                         const std::map<std::string, std::string>& metadata) {
+  std::string written;
+  if (!o.output.empty()) {
+    writeImage(o.output, image, metadata);
+    written = o.output;
+  }
+  if (!o.film.empty() && film.passes() > 0) {
+    saveFilm(o.film, film, s.fingerprint, "--film");
+    written += (written.empty() ? "" : " and ") + o.film + " (passes " + std::to_string(film.firstPass()) + ":" +
+               std::to_string(film.firstPass() + film.passes()) + ")";
+  }
+  return written;
 }
 
 // The render's facts in the image file's metadata.
@@ -269,27 +283,25 @@ int runRender(RenderOptions o) {
   const double spp = debugView ? double(r.stats.samples) / double(r.film.pixels()) : r.film.count(0);
   const double estimatedRelMse = debugView ? 0.0 : r.film.estimatedRelMse();
   std::map<std::string, std::string> metadata = imageMetadata(o, scene, r, method, spp, seconds, estimatedRelMse);
-  const Image image = imageWithLayers(r.film, layers);
+  const Image image = r.film.imageWithLayers(layers);
   const std::string passes = std::to_string(uint64_t(r.film.count(0))) + " passes";
   if (r.stopped) {
     const int signal = settings.stop->load();
     if (r.film.count(0) == 0) throw Interrupted("before any pass was finished; nothing written", signal);
     metadata["incomplete"] = "interrupted by signal " + std::to_string(signal);
-    writeImage(o.output, image, metadata);
-    throw Interrupted("wrote the " + passes + " finished so far to " + o.output +
+    throw Interrupted("wrote the " + passes + " finished so far to " + writeOutputs(o, settings, r.film, image, metadata) +
                           (o.checkpoint.empty() ? "" : " and a checkpoint to " + o.checkpoint +
                                                            " (go on with --resume " + o.checkpoint + ")"),
                       signal);
   }
   if (!r.complete) {
     metadata["incomplete"] = "every device failed";
-    writeImage(o.output, image, metadata);
-    throw Error("every device failed before the render was complete; wrote the " + passes +
-                " finished so far to " + o.output);
+    throw Error("every device failed before the render was complete; wrote the " + passes + " finished so far to " +
+                writeOutputs(o, settings, r.film, image, metadata));
   }
-  writeImage(o.output, image, metadata);
+  const std::string written = writeOutputs(o, settings, r.film, image, metadata);
   printSummary(o, settings, scene, r, method, spp, seconds, estimatedRelMse);
-  std::cout << "wrote " << o.output << "\n";
+  std::cout << "wrote " << written << "\n";
   return 0;
 }
 

@@ -15,7 +15,8 @@
 namespace fh {
 namespace {
 
-constexpr const char* kMagic = "fredholm-checkpoint-1";
+// Version 2: the header names the film's first pass (chunks), and samples are quantized.
+constexpr const char* kMagic = "fredholm-film-2";
 
 // FNV-1a, 64 bits, over whatever bytes are fed to it.
 class Fingerprint {
@@ -68,48 +69,63 @@ std::string renderFingerprint(const Scene& scene, const Camera& camera, const Re
   return f.hex();
 }
 
-void saveCheckpoint(const std::string& path, const Film& film, const std::string& fingerprint) {
+void saveFilm(const std::string& path, const Film& film, const std::string& fingerprint, const std::string& flag) {
   std::ostringstream out;
-  out << kMagic << ' ' << fingerprint << ' ' << film.width << ' ' << film.height << ' ' << film.passes() << ' '
-      << film.aovSum.size() << ' ' << film.oddSum.size() << '\n';
+  out << kMagic << ' ' << fingerprint << ' ' << film.width << ' ' << film.height << ' ' << film.firstPass() << ' '
+      << film.passes() << ' ' << film.aovSum.size() << ' ' << film.oddSum.size() << '\n';
   for (const std::vector<double>* v : sums(film))
     out.write(reinterpret_cast<const char*>(v->data()), std::streamsize(v->size() * 8));
-  writeTextAtomically(path, "--checkpoint", out.str());
+  writeTextAtomically(path, flag, out.str());
 }
 
-Film loadCheckpoint(const std::string& path, const std::string& fingerprint, const std::string& flag) {
+void saveCheckpoint(const std::string& path, const Film& film, const std::string& fingerprint) {
+  saveFilm(path, film, fingerprint, "--checkpoint");
+}
+
+SavedFilm readFilm(const std::string& path, const std::string& flag) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(flag + " '" + path + "': cannot read the file");
   std::string magic, saved;
   int width = 0, height = 0;
-  uint64_t passes = 0;
+  uint64_t first = 0, passes = 0;
   size_t aovs = 0, odd = 0;
-  in >> magic >> saved >> width >> height >> passes >> aovs >> odd;
+  in >> magic >> saved >> width >> height >> first >> passes >> aovs >> odd;
   if (!in || magic != kMagic || in.get() != '\n' || width <= 0 || height <= 0 ||
-      uint64_t(width) * uint64_t(height) > (uint64_t(1) << 28))
-    throw Error(flag + " '" + path + "': not a fredholm checkpoint");
-  if (saved != fingerprint)
-    throw Error(flag + " '" + path + "': saved by a render of another scene, camera or settings (size, seed, "
-                "method, depths, environment, filter, --noise, --aovs); resume with the same ones");
+      uint64_t(width) * uint64_t(height) > (uint64_t(1) << 28) || first >= (uint64_t(1) << 32) ||
+      passes > (uint64_t(1) << 32))
+    throw Error(flag + " '" + path + "': not a fredholm film or checkpoint");
   // The sums' sizes follow from the header: checked against the file before allocating.
   const uint64_t pixels = uint64_t(width) * uint64_t(height);
   if ((aovs != 0 && aovs != pixels * kAovSumsPerPixel) || (odd != 0 && odd != pixels * 3))
-    throw Error(flag + " '" + path + "': not a fredholm checkpoint");
+    throw Error(flag + " '" + path + "': not a fredholm film or checkpoint");
   const auto body = in.tellg();
   in.seekg(0, std::ios::end);
   const uint64_t bytes = uint64_t(in.tellg() - body);
   in.seekg(body);
   if (bytes != (8 * pixels + aovs + odd) * 8) throw Error(flag + " '" + path + "': the file is cut short");
-  Film film(width, height, aovs > 0, odd > 0);
-  for (std::vector<double>* v : sums(film))
+  SavedFilm f{Film(width, height, aovs > 0, odd > 0, first), saved};
+  for (std::vector<double>* v : sums(f.film))
     if (!in.read(reinterpret_cast<char*>(v->data()), std::streamsize(v->size() * 8)))
       throw Error(flag + " '" + path + "': the file is cut short");
-  if (in.peek() != std::char_traits<char>::eof()) throw Error(flag + " '" + path + "': not a fredholm checkpoint");
+  if (in.peek() != std::char_traits<char>::eof())
+    throw Error(flag + " '" + path + "': not a fredholm film or checkpoint");
   // Every pass adds one sample to every pixel.
-  for (size_t p = 0; p < film.pixels(); ++p)
-    if (film.count(p) != double(passes)) throw Error(flag + " '" + path + "': the film's sample counts do not add up");
-  film.resumeAt(passes);
-  return film;
+  for (size_t p = 0; p < f.film.pixels(); ++p)
+    if (f.film.count(p) != double(passes)) throw Error(flag + " '" + path + "': the film's sample counts do not add up");
+  f.film.resumeAt(passes);
+  return f;
+}
+
+Film loadCheckpoint(const std::string& path, const std::string& fingerprint, const std::string& flag) {
+  SavedFilm f = readFilm(path, flag);
+  if (f.fingerprint != fingerprint)
+    throw Error(flag + " '" + path + "': saved by a render of another scene, camera or settings (size, seed, "
+                "method, depths, environment, filter, --noise, --aovs); resume with the same ones");
+  if (f.film.firstPass() != 0)
+    throw Error(flag + " '" + path + "': a chunk of passes " + std::to_string(f.film.firstPass()) + ":" +
+                std::to_string(f.film.firstPass() + f.film.passes()) + ", not a checkpoint; merge chunks with "
+                "fredholm merge");
+  return std::move(f.film);
 }
 
 }  // namespace fh

@@ -19,11 +19,23 @@ namespace fh {
 // same bits). A hex string.
 std::string renderFingerprint(const Scene& scene, const Camera& camera, const RenderSettings& settings);
 
-// Writes the film atomically (a temporary file renamed over `path`).
+// Writes the film with the render's fingerprint, atomically (a temporary file renamed over
+// `path`); errors name `flag`. The same format serves checkpoints and chunks (--film).
+void saveFilm(const std::string& path, const Film& film, const std::string& fingerprint, const std::string& flag);
 void saveCheckpoint(const std::string& path, const Film& film, const std::string& fingerprint);
 
-// The film saved at `path`; throws fh::Error naming `flag` and the file if it cannot be
-// read, is cut short, or was saved by another render (another fingerprint).
+// A film file as saved: the film (its first pass and pass count included) and the
+// fingerprint of the render that saved it. Throws fh::Error naming `flag` and the file if
+// it cannot be read, is cut short or is not consistent.
+struct SavedFilm {
+  Film film;
+  std::string fingerprint;
+};
+SavedFilm readFilm(const std::string& path, const std::string& flag);
+
+// The checkpoint saved at `path`; throws fh::Error naming `flag` and the file if it cannot
+// be read, is cut short, was saved by another render (another fingerprint), or is a chunk
+// that does not start at pass 0.
 Film loadCheckpoint(const std::string& path, const std::string& fingerprint, const std::string& flag);
 
 }  // namespace fh

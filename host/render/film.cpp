@@ -2,24 +2,46 @@
 #include "render/film.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "image/error_metrics.h"
 
 namespace fh {
 
-Film::Film(int w, int h, bool surfaceAovs, bool twoReplicates)
+namespace {
+
+// v rounded to a whole number of film quanta.
+double quantized(float v) { return std::nearbyint(double(v) / kFilmQuantum) * kFilmQuantum; }
+
+void addEach(std::vector<double>& to, const std::vector<double>& from) {
+  for (size_t i = 0; i < to.size(); ++i) to[i] += from[i];
+}
+
+}  // namespace
+
+Film::Film(int w, int h, bool surfaceAovs, bool twoReplicates, uint64_t firstPass)
     : width(w), height(h), sum(pixels() * 4, 0.0), sumSq(pixels() * 4, 0.0),
-      aovSum(surfaceAovs ? pixels() * kAovSumsPerPixel : 0, 0.0), oddSum(twoReplicates ? pixels() * 3 : 0, 0.0) {}
+      aovSum(surfaceAovs ? pixels() * kAovSumsPerPixel : 0, 0.0), oddSum(twoReplicates ? pixels() * 3 : 0, 0.0),
+      firstPass_(firstPass) {}
+
+void Film::merge(const Film& other) {
+  addEach(sum, other.sum);
+  addEach(sumSq, other.sumSq);
+  addEach(aovSum, other.aovSum);
+  addEach(oddSum, other.oddSum);
+  passes_ += other.passes_;
+  firstPass_ = std::min(firstPass_, other.firstPass_);
+}
 
 void Film::addPass(const std::vector<float>& samples) {
   for (size_t i = 0; i < sum.size(); ++i) {
-    const double v = samples[i];
+    const double v = quantized(samples[i]);
     sum[i] += v;
     if (i % 4 != 3) sumSq[i] += v * v;
   }
-  if (!oddSum.empty() && passes_ % 2 == 1)
+  if (!oddSum.empty() && (firstPass_ + passes_) % 2 == 1)
     for (size_t p = 0; p < pixels(); ++p)
-      for (size_t c = 0; c < 3; ++c) oddSum[3 * p + c] += samples[4 * p + c];
+      for (size_t c = 0; c < 3; ++c) oddSum[3 * p + c] += quantized(samples[4 * p + c]);
   ++passes_;
   if (!hasSurfaceAovs()) return;
   const float* aovs = samples.data() + sum.size();
@@ -27,11 +49,11 @@ void Film::addPass(const std::vector<float>& samples) {
     const float* in = aovs + kAovFloatsPerPixel * p;  // albedo rgb, flag, normal xyz, distance
     double* out = &aovSum[kAovSumsPerPixel * p];
     for (size_t c = 0; c < 3; ++c) {
-      out[c] += in[c];
-      out[3 + c] += in[4 + c];
+      out[c] += quantized(in[c]);
+      out[3 + c] += quantized(in[4 + c]);
     }
     if (in[7] > 0.f) {
-      out[6] += in[7];
+      out[6] += quantized(in[7]);
       out[7] += 1.0;
     }
   }
@@ -41,7 +63,7 @@ double Film::estimatedRelMse() const {
   const bool replicated = !oddSum.empty() && passes_ >= 2;
   // The mean of nEven and nOdd passes: its variance is D^2 nEven nOdd / n^2 in expectation,
   // D the difference of the halves' means (each half's variance proportional to 1 / count).
-  const double nOdd = double(passes_ / 2), nEven = double(passes_) - nOdd;
+  const double nOdd = double((firstPass_ + passes_) / 2 - firstPass_ / 2), nEven = double(passes_) - nOdd;
   double total = 0.0;
   for (size_t p = 0; p < pixels(); ++p) {
     const double n = count(p);
@@ -101,6 +123,32 @@ std::array<double, 3> Film::varianceOfMean(size_t p) const {
     v[c] = sampleVariance / n;
   }
   return v;
+}
+
+Image Film::imageWithLayers(const std::vector<std::string>& layers) const {
+  Image image = this->image();
+  for (const std::string& name : layers) {
+    ImageLayer layer{name, {}, {}};
+    if (name == "albedo") {
+      layer.channels = {"R", "G", "B"};
+      layer.values = albedo();
+    } else if (name == "normal") {
+      layer.channels = {"X", "Y", "Z"};
+      layer.values = normal();
+    } else if (name == "depth") {
+      layer.channels = {"Z"};
+      layer.values = depth();
+    } else if (name == "variance") {
+      layer.channels = {"R", "G", "B"};
+      for (size_t p = 0; p < pixels(); ++p)
+        for (double v : varianceOfMean(p)) layer.values.push_back(float(v));
+    } else {  // spp
+      layer.channels = {"Y"};
+      for (size_t p = 0; p < pixels(); ++p) layer.values.push_back(float(count(p)));
+    }
+    image.layers.push_back(std::move(layer));
+  }
+  return image;
 }
 
 }  // namespace fh

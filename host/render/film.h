@@ -1,10 +1,19 @@
 // The film: every finished pass of a render, merged in pass order in double precision,
 // whichever device rendered it. Per pixel it keeps the sum of samples (rgb, w: count)
 // and the sum of their squares, from which the variance of the pixel's mean follows.
+//
+// Sums that do not depend on the order they were added in: every sample is rounded to a
+// whole number of kFilmQuantum before it is added (to the radiance sums, the odd passes'
+// and the surface layers'), so each sum is an integer number of quanta, which double
+// precision adds exactly while it stays below 2^53 quanta (a pixel's samples summing to
+// 2^29, about 5e8). Films of disjoint passes (chunks rendered apart, --passes) then merge
+// into the same bits as one render of them all. The sums of squares are plain doubles
+// (a sample's square is not a whole number of quanta): the variance agrees to rounding.
 #pragma once
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "image/image_io.h"
@@ -16,18 +25,28 @@ namespace fh {
 constexpr size_t kAovFloatsPerPixel = 8;
 // The film's sums of them per pixel (Film::aovSum): albedo rgb, normal xyz, depth, hits.
 constexpr size_t kAovSumsPerPixel = 8;
+// The resolution samples are rounded to before the film adds them: 2^-24.
+constexpr double kFilmQuantum = 1.0 / 16777216.0;
 
 struct Film {
   Film() = default;
   // twoReplicates: even and odd passes come from independently scrambled sequences
-  // (RenderParams::replicates), which estimatedRelMse compares.
-  Film(int w, int h, bool surfaceAovs = false, bool twoReplicates = false);
+  // (RenderParams::replicates), which estimatedRelMse compares. firstPass: the render's
+  // pass the film starts at (a chunk's, --passes A:B; else 0).
+  Film(int w, int h, bool surfaceAovs = false, bool twoReplicates = false, uint64_t firstPass = 0);
 
-  // Adds one pass: per pixel (rgb, 1), pixel-major, as the device's pass buffer holds it,
-  // then, for a film with surface AOVs, kAovFloatsPerPixel per pixel.
+  // Adds the next pass (firstPass() + passes()): per pixel (rgb, 1), pixel-major, as the
+  // device's pass buffer holds it, then, for a film with surface AOVs, kAovFloatsPerPixel
+  // per pixel.
   void addPass(const std::vector<float>& samples);
+  // Adds another film's passes: a chunk of the same render (same size and layers) whose
+  // passes this film lacks; the caller checks which they are. Exact but for sumSq.
+  void merge(const Film& other);
 
   Image image() const;  // the mean per pixel
+  // The image with --aovs layers beside it (albedo, normal, depth, variance, spp, in the
+  // order given), named as compositors and denoisers read them (albedo.R, depth.Z).
+  Image imageWithLayers(const std::vector<std::string>& layers) const;
   // The variance of the pixel's mean estimate, per channel (sample variance / count).
   std::array<double, 3> varianceOfMean(size_t pixel) const;
   // The image's expected relMSE against the converged image, estimated from the film alone:
@@ -38,7 +57,8 @@ struct Film {
   // which overstates the error of low-discrepancy samples (they are not independent).
   double estimatedRelMse() const;
   uint64_t passes() const { return passes_; }
-  // A film read back from a checkpoint holds passes 0 .. passes - 1.
+  uint64_t firstPass() const { return firstPass_; }
+  // A film read back from a file holds passes firstPass .. firstPass + passes - 1.
   void resumeAt(uint64_t passes) { passes_ = passes; }
   double count(size_t pixel) const { return sum[4 * pixel + 3]; }
   size_t pixels() const { return size_t(width) * size_t(height); }
@@ -60,7 +80,7 @@ struct Film {
 
  private:
   std::vector<float> aovMean(size_t first) const;
-  uint64_t passes_ = 0;
+  uint64_t firstPass_ = 0, passes_ = 0;
 };
 
 // The depth of a pixel where nothing was hit (as Cycles writes its background's).

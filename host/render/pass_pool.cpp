@@ -20,11 +20,11 @@ PassPool::PassPool(const RenderSettings& s, int workers)
       start_(std::chrono::steady_clock::now()),
       outstanding_(size_t(workers)),
       done_(size_t(workers), 0),
-      film_(s.resume ? *s.resume : Film(s.width, s.height, s.surfaceAovs, s.replicates() == 2)),
+      film_(s.resume ? *s.resume : Film(s.width, s.height, s.surfaceAovs, s.replicates() == 2, s.firstPass)),
       progress_(s.progress),
       lastCheckpoint_(std::chrono::steady_clock::now()) {
-  // A resumed render goes on from the first pass its film lacks.
-  next_ = nextToMerge_ = uint32_t(film_.passes());
+  // A resumed render goes on from the first pass its film lacks; a chunk starts at its first.
+  next_ = nextToMerge_ = uint32_t(film_.firstPass() + film_.passes());
   merged_ = film_.passes();
   // ... unless it met its noise target already (a render that stopped there).
   noiseReached_ = s.resume && s.noise > 0.0 && film_.passes() >= kNoiseMinPasses &&
@@ -108,6 +108,7 @@ Film PassPool::finish(bool& complete) {
   complete = noiseReached_ || (pending_.empty() && requeued_.empty() && !anyOutstanding());
   for (auto& [pass, samples] : pending_) {
     if (noiseReached_) break;  // beyond the pass that met the target
+    if (!settings_.filmPath.empty()) break;  // a film for merging holds consecutive passes
     film_.addPass(samples);
     ++merged_;
   }
@@ -177,7 +178,8 @@ void PassPool::showProgress() {
   const bool timed = settings_.seconds > 0.0, noisy = settings_.noise > 0.0;
   // relMSE falls as 1 / samples, so target / estimate is the share of samples taken.
   const double noiseShare = noiseEstimate_ > 0.0 ? std::min(1.0, settings_.noise / noiseEstimate_) : 0.0;
-  progress_.update(merged_ * film_.pixels(), timed || noisy ? 0 : uint64_t(total_) * film_.pixels(), elapsed,
+  const uint64_t passes = total_ - film_.firstPass();
+  progress_.update(merged_ * film_.pixels(), timed || noisy ? 0 : passes * film_.pixels(), elapsed,
                    noisy ? std::min(1.0, std::max(noiseShare, timed ? elapsed / settings_.seconds : 0.0))
                          : timed ? std::min(1.0, elapsed / settings_.seconds) : 0.0);
 }

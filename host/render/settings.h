@@ -5,6 +5,7 @@
 #include <array>
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -35,6 +36,9 @@ constexpr unsigned kNoiseMinPasses = 16;
 struct RenderSettings {
   int width = 512, height = 512;
   int spp = 64;          // samples per pixel; with seconds > 0, the most to take
+  // --passes A:B renders only the chunk of passes firstPass (A) .. spp - 1 (B = spp), into a
+  // film that merges with the other chunks' (fredholm merge) into the image of all of them.
+  uint32_t firstPass = 0;
   double seconds = 0.0;  // time budget: stop at the end of the pass running when it is spent
   // Noise target: stop once the film's estimated relMSE (Film::estimatedRelMse) is at most
   // this, checked after each pass from kNoiseMinPasses on; 0: none.
@@ -63,6 +67,10 @@ struct RenderSettings {
   // checkpointSeconds and when the render ends, with the render's fingerprint
   // (render/checkpoint.h); empty: none.
   std::string checkpointPath;
+  // --film: the film is saved for fredholm merge (by the command line), so it must hold
+  // passes firstPass .. firstPass + n - 1 and no others: passes finished beyond a gap (a
+  // pass lost to a signal or a failed device) are dropped rather than merged.
+  std::string filmPath;
   double checkpointSeconds = 60.0;
   std::string fingerprint;
   // --resume: a saved film to go on from (it holds passes 0 .. resume->passes() - 1).

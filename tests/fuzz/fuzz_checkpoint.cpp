@@ -1,6 +1,6 @@
-// Checkpoint files, as --resume reads them: the fingerprint a render would expect is taken
-// from the input's own header (else nothing past it is reached); any file must load to a
-// consistent film or throw fh::Error.
+// Film files, as --resume reads a checkpoint (the fingerprint a render would expect is taken
+// from the input's own header, else nothing past it is reached) and as fredholm merge reads
+// a chunk: any file must load to a consistent film or throw fh::Error.
 #include <string>
 
 #include "base/error.h"
@@ -17,6 +17,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (film.sum.size() != 4 * film.pixels() || film.count(0) != double(film.passes())) __builtin_trap();
     film.image();
     film.estimatedRelMse();
+  } catch (const fh::Error&) {
+  }
+  try {
+    const fh::SavedFilm saved = fh::readFilm(path, "merge");
+    fh::Film twice = saved.film;
+    twice.merge(saved.film);
+    if (twice.passes() != 2 * saved.film.passes() || twice.count(0) != 2 * saved.film.count(0)) __builtin_trap();
+    twice.image();
   } catch (const fh::Error&) {
   }
   return 0;
