@@ -13,6 +13,7 @@ PACKAGES=(build-essential cmake ninja-build pkg-config
           pocl-opencl-icd ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers clinfo
           libopenimageio-dev openimageio-tools libtinyobjloader-dev libgtest-dev
           libcli11-dev nlohmann-json3-dev
+          openmpi-bin libopenmpi-dev   # renders shared by the ranks of an mpirun job
           clang oclgrind   # the portability gates: offline compiles for other targets, a device simulator
           libclang-rt-14-dev)  # sanitizers and libFuzzer for clang (tests/sanitize.sh)
 # Optional: Embree for the bench comparison, matplotlib for the charts.

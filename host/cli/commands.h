@@ -10,6 +10,8 @@
 
 namespace fh {
 
+class MpiSession;
+
 struct RenderOptions {
   std::string scene;
   std::string output;
@@ -32,6 +34,8 @@ struct RenderOptions {
   std::string aovs;  // --aovs: layers written beside the image in one EXR
   std::string checkpoint, resume;  // --checkpoint FILE, --resume FILE
   std::string passes, film;        // --passes A:B (a chunk), --film FILE (the film, for fredholm merge)
+  // Under mpirun (host/distributed): the job this process is a rank of; null otherwise.
+  const MpiSession* mpi = nullptr;
   double checkpointEvery = RenderSettings{}.checkpointSeconds;
   std::string device;
 };

@@ -10,6 +10,11 @@
 #ifdef FREDHOLM_HAVE_EMBREE
 #include "embree_tracer.h"
 #endif
+#ifdef FREDHOLM_HAVE_MPI
+#include <memory>
+
+#include "distributed/mpi_render.h"
+#endif
 
 using namespace fh;
 
@@ -183,6 +188,21 @@ int main(int argc, char** argv) {
     std::cerr << "fredholm: error: " << e.what() << " (see fredholm " << (app.get_subcommands().empty() ? "" : app.get_subcommands().front()->get_name() + " ") << "--help)\n";
     return 1;
   }
+#ifdef FREDHOLM_HAVE_MPI
+  // Under mpirun a render is shared by the job's ranks (host/distributed); an error on one
+  // rank ends the job, as the others would wait for it.
+  std::unique_ptr<MpiSession> mpi;
+  if (*rendering && startedByMpirun()) {
+    mpi = std::make_unique<MpiSession>(&argc, &argv);
+    render.mpi = mpi.get();
+  }
+  const auto failed = [&](int code) {
+    if (mpi && mpi->size() > 1) mpi->abort(code);
+    return code;
+  };
+#else
+  const auto failed = [](int code) { return code; };
+#endif
   try {
     if (*devices) return runDevices(devicesSpec);
     if (*rendering) return runRender(render);
@@ -193,16 +213,16 @@ int main(int argc, char** argv) {
     if (*merging) return runMerge(merge);
   } catch (const Interrupted& e) {
     std::cerr << "fredholm: interrupted: " << e.what() << "\n";
-    return e.exitCode();
+    return failed(e.exitCode());
   } catch (const BuildError& e) {
     std::cerr << "fredholm: error: " << e.what() << "\n";
-    return 1;
+    return failed(1);
   } catch (const Error& e) {
     std::cerr << "fredholm: error: " << e.what() << "\n";
-    return 1;
+    return failed(1);
   } catch (const std::exception& e) {
     std::cerr << "fredholm: internal error: " << e.what() << "\n";
-    return 3;
+    return failed(3);
   }
   return 0;
 }

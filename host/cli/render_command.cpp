@@ -21,6 +21,9 @@
 #include "render/render_aov.h"
 #include "render/wavefront.h"
 #include "scene/environment_map.h"
+#ifdef FREDHOLM_HAVE_MPI
+#include "distributed/mpi_render.h"
+#endif
 
 namespace fh {
 namespace {
@@ -174,17 +177,16 @@ void reportDevices(const RenderResult& r) {
 
 // The --aovs layers, parsed and checked against the other flags and the output; picks the
 // default output name (PNG, or EXR with layers) and checks every output file before work.
-std::vector<std::string> checkOutputs(RenderOptions& o, RenderSettings& settings) {
+std::vector<std::string> checkOutputs(RenderOptions& o, RenderSettings& settings, bool writes) {
   const std::vector<std::string> layers = o.aovs.empty() ? std::vector<std::string>{} : parseAovLayers(o.aovs);
   if (!o.aov.empty() && !layers.empty()) throw Error("--aov (a debug view) and --aovs (layers beside the image): pick one");
   for (const auto& layer : layers) settings.surfaceAovs |= isSurfaceAov(layer);
   // An explicit -o is never overwritten without --force; the default name steps aside.
   // With --film the film is the output, and an image is written only where -o asks.
   if (o.output.empty() && o.film.empty()) o.output = firstFreeName(layers.empty() ? "fredholm.png" : "fredholm.exr");
-  if (!o.film.empty()) {
-    if (!o.aov.empty()) throw Error("--film saves a render's passes; --aov renders none");
-    checkOutputFile(o.film, o.force, "--film");
-  }
+  if (!o.film.empty() && !o.aov.empty()) throw Error("--film saves a render's passes; --aov renders none");
+  if (!writes) return layers;  // another rank than the one that writes
+  if (!o.film.empty()) checkOutputFile(o.film, o.force, "--film");
   if (!o.output.empty()) checkOutputPath(o.output, o.force);
   if (!layers.empty() && !o.output.empty() && extensionOf(o.output) != ".exr")
     throw Error("--aovs: layers are written into one EXR; -o '" + o.output + "' is not an .exr file");
@@ -197,6 +199,33 @@ std::vector<std::string> checkOutputs(RenderOptions& o, RenderSettings& settings
   settings.filmPath = o.film;
   settings.checkpointSeconds = o.checkpointEvery;
   return layers;
+}
+
+// This process's rank when it is one of several sharing the render (mpirun), else 0.
+int mpiRank(const RenderOptions& o) {
+#ifdef FREDHOLM_HAVE_MPI
+  if (o.mpi) return o.mpi->rank();
+#endif
+  (void)o;
+  return 0;
+}
+
+// Under mpirun: what a render shared by ranks cannot do (yet), refused on every rank alike;
+// and no progress bars (every rank's stderr reaches the terminal).
+void checkSharedRender(const RenderOptions& o, RenderSettings& settings) {
+  const char* clash = o.noise > 0 ? "--noise" : !o.checkpoint.empty() ? "--checkpoint" : !o.resume.empty() ? "--resume"
+                      : !o.aov.empty() ? "--aov" : nullptr;
+  if (clash) throw Error(std::string("under mpirun, ranks share a render without ") + clash + " (not yet supported)");
+  settings.progress = false;
+}
+
+RenderResult renderOnEveryRank(const RenderOptions& o, const std::vector<DeviceInfo>& devices, const Scene& scene,
+                               const Bvh& bvh, const Camera& camera, const RenderSettings& settings) {
+#ifdef FREDHOLM_HAVE_MPI
+  if (o.mpi) return renderAcrossRanks(*o.mpi, devices, scene, bvh, camera, settings);
+#endif
+  (void)o;
+  return render(devices, scene, bvh, camera, settings);
 }
 
 // Writes the image where -o names one and the film for --film; returns what was written.
@@ -239,6 +268,7 @@ void printSummary(const RenderOptions& o, const RenderSettings& settings, const 
             << scene.lights.size() << " emissive; "
             << (o.allFeatures ? "all features" : featuresFor(scene, settings).describe())
             << ") with " << method << ", " << o.width << "x" << o.height << ", " << spp << " spp on "
+            << (r.stats.ranks.empty() ? "" : std::to_string(r.stats.ranks.size()) + " ranks, rank 0 on ")
             << r.stats.contributors() << " in " << formatSeconds(seconds) << " s\n";
   if (settings.noise > 0) {
     const bool met = noise <= settings.noise;
@@ -254,7 +284,9 @@ int runRender(RenderOptions o) {
   settings.stop = &installInterruptHandlers();
   const bool debugView = !o.aov.empty();
   const Aov aov = debugView ? parseAov(o.aov) : Aov::Albedo;
-  const std::vector<std::string> layers = checkOutputs(o, settings);
+  const int rank = mpiRank(o);
+  if (o.mpi) checkSharedRender(o, settings);
+  const std::vector<std::string> layers = checkOutputs(o, settings, rank == 0);
   const auto devices = selectDevices(listDevices(), o.device);
   if (debugView && devices.size() > 1)
     throw Error("--aov renders on one device, and --device '" + o.device + "' selects " +
@@ -272,7 +304,8 @@ int runRender(RenderOptions o) {
   const auto start = std::chrono::steady_clock::now();
   const Bvh bvh = buildBvh(scene);
   const RenderResult r = debugView ? renderDebugView(aov, devices, scene, bvh, camera, settings)
-                                   : render(devices, scene, bvh, camera, settings);
+                                   : renderOnEveryRank(o, devices, scene, bvh, camera, settings);
+  if (rank != 0) return 0;  // rank 0 holds the film, and writes
   const std::string method = debugView ? "aov:" + o.aov : methodName(settings.method);
   reportDevices(r);
   if (!o.statsFile.empty() && !debugView) {

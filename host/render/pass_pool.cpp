@@ -65,14 +65,25 @@ bool PassPool::take(int worker, uint32_t& pass) {
       break;
     }
     if (noiseReached_) return false;
-    if (next_ < total_ && !outOfTime()) {
-      pass = next_++;
-      break;
-    }
+    if (nextNewPass(pass)) break;
     if (!outstanding_[size_t(worker)].empty() || !anyOutstanding()) return false;
     changed_.wait(lock);
   }
   outstanding_[size_t(worker)].insert(pass);
+  return true;
+}
+
+// A pass no one has rendered yet: from the ledger where processes share the render, else
+// the next in this process's count, while the sample count and the time budget allow.
+bool PassPool::nextNewPass(uint32_t& pass) {
+  if (settings_.ledger) {
+    if (ledgerDry_) return false;
+    if (settings_.ledger->next(pass)) return true;
+    ledgerDry_ = true;  // ask no more: for another process, each question is a message
+    return false;
+  }
+  if (next_ >= total_ || outOfTime()) return false;
+  pass = next_++;
   return true;
 }
 
@@ -125,12 +136,14 @@ bool PassPool::anyOutstanding() const {
 
 // The merger thread: passes join the film in pass order, so the image for a seed is the
 // same bits whichever devices rendered which passes, and in whatever order they finished.
-// A pass is added outside the lock: workers hand over passes meanwhile.
+// With a ledger (processes sharing the render) this process holds some passes only, and
+// they join as they come. A pass is added outside the lock: workers hand over passes meanwhile.
 void PassPool::mergeInOrder() {
   std::unique_lock<std::mutex> lock(mutex_);
+  const bool anyOrder = settings_.ledger != nullptr;
   for (;;) {
-    changed_.wait(lock, [&] { return stopping_ || pending_.count(nextToMerge_) > 0; });
-    const auto next = pending_.find(nextToMerge_);
+    changed_.wait(lock, [&] { return stopping_ || (anyOrder ? !pending_.empty() : pending_.count(nextToMerge_) > 0); });
+    const auto next = anyOrder ? pending_.begin() : pending_.find(nextToMerge_);
     if (next == pending_.end()) return;  // stopping, and the next pass is not in
     std::vector<float> samples;
     samples.swap(next->second);

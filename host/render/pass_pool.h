@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "render/film.h"
+#include "render/pass_ledger.h"
 #include "render/pass_source.h"
 #include "render/progress.h"
 #include "render/settings.h"
@@ -44,6 +45,7 @@ class PassPool : public PassSource {
 
  private:
   bool anyOutstanding() const;
+  bool nextNewPass(uint32_t& pass);
   bool outOfTime() const;
   void mergeInOrder();
   void stopMerging();
@@ -70,6 +72,7 @@ class PassPool : public PassSource {
   std::vector<std::string> warnings_;
   long killAfter_ = -1;  // FREDHOLM_KILL_AFTER_PASSES (tests): SIGKILL once that many are saved
   bool noiseReached_ = false;
+  bool ledgerDry_ = false;  // the ledger said no more
   double noiseEstimate_ = -1.0;  // the film's at the last check of a noise target
   std::thread merger_;
 };

@@ -71,6 +71,19 @@ std::string statsJson(const RenderStats& st, const RenderSettings& s) {
       {"rays", {{"camera", st.cameraRays}, {"bounce", st.bounceRays}, {"shadow", st.shadowRays}, {"total", rays}}},
       {"rays_per_second", st.seconds > 0 ? double(rays) / st.seconds : 0.0},
       {"kernels", kernels}};
+  if (!st.ranks.empty()) {
+    const double pixels = double(s.width) * double(s.height);
+    nlohmann::json ranks = nlohmann::json::array();
+    for (const auto& r : st.ranks)
+      ranks.push_back({{"rank", r.rank},
+                       {"passes", r.passes},
+                       {"samples_per_second", r.seconds > 0 ? double(r.passes) * pixels / r.seconds : 0.0},
+                       {"seconds", r.seconds},
+                       {"idle_seconds", r.idleSeconds},
+                       {"bytes_sent", r.bytesSent},
+                       {"devices", r.devices}});
+    doc["ranks"] = ranks;
+  }
   return doc.dump(2);
 }
 

@@ -21,6 +21,15 @@ struct RenderStats {
     std::string error;  // why the device stopped early, if it did
   };
   std::vector<DeviceShare> devices;
+  // One per process when several shared the render (host/distributed), by rank; on rank 0.
+  struct RankShare {
+    int rank = 0;
+    uint64_t passes = 0;
+    double seconds = 0.0, idleSeconds = 0.0;  // rendering; waiting for the last rank to finish
+    uint64_t bytesSent = 0;                   // the film and the pass requests
+    std::string devices;
+  };
+  std::vector<RankShare> ranks;
   uint64_t samples = 0, nonfinite = 0;
   double seconds = 0.0;
   uint64_t cameraRays = 0, bounceRays = 0, shadowRays = 0;

@@ -13,6 +13,7 @@ namespace fh {
 
 struct EnvironmentMap;
 struct Film;
+class PassLedger;
 
 enum class Method { PT, NEE, MIS };
 const char* methodName(Method m);
@@ -75,6 +76,11 @@ struct RenderSettings {
   std::string fingerprint;
   // --resume: a saved film to go on from (it holds passes 0 .. resume->passes() - 1).
   std::shared_ptr<const Film> resume;
+  // Where new passes come from when several processes share the render (render/pass_ledger.h;
+  // the ledger then owns the sample count and time budget); null: the pool counts them. The
+  // film then holds whichever passes this process rendered, added as they finish (its sums
+  // are exact, render/film.h, so the order does not matter but for sumSq's rounding).
+  PassLedger* ledger = nullptr;
   // Set (non-zero) to stop early, as Ctrl-C does: passes in flight are dropped, those
   // finished are kept. Null: never.
   const std::atomic<int>* stop = nullptr;

@@ -1,0 +1,206 @@
+// Passes handed out by rank 0, films summed onto it.
+#include "distributed/mpi_render.h"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "render/pass_ledger.h"
+
+namespace fh {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Messages to rank 0: a request for a pass (answered with kTagPass: the pass, or -1 for
+// none left), or a rank's goodbye once its render is over.
+constexpr int kTagRequest = 1, kTagPass = 2, kTagBye = 3;
+
+// FREDHOLM_SLOW_RANK=r: rank r is slowed on purpose (tests), as a rank on a slower machine.
+void slowDownIfAsked(int rank) {
+  const char* slow = std::getenv("FREDHOLM_SLOW_RANK");
+  if (slow && *slow && std::atoi(slow) == rank) std::this_thread::sleep_for(std::chrono::milliseconds(200));
+}
+
+// Rank 0's ledger: the render's pass count and time budget, for its own pool (next) and,
+// on the server thread, for every other rank's requests.
+class RootLedger : public PassLedger {
+ public:
+  RootLedger(uint32_t total, double seconds) : total_(total), seconds_(seconds) {}
+
+  bool next(uint32_t& pass) override {
+    slowDownIfAsked(0);
+    return take(pass);
+  }
+
+  // Answers the other ranks until each has said goodbye.
+  void serve(int ranks) {
+    for (int byes = 0; byes < ranks - 1;) {
+      int64_t message = 0;
+      MPI_Status status;
+      MPI_Recv(&message, 1, MPI_INT64_T, MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &status);
+      if (status.MPI_TAG == kTagBye) {
+        ++byes;
+        continue;
+      }
+      uint32_t pass = 0;
+      int64_t reply = take(pass) ? int64_t(pass) : -1;
+      MPI_Send(&reply, 1, MPI_INT64_T, status.MPI_SOURCE, kTagPass, MPI_COMM_WORLD);
+      bytes += sizeof reply;
+    }
+  }
+
+  uint64_t bytes = 0;  // sent: the answers
+ private:
+  bool take(uint32_t& pass) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!started_) {  // the time budget counts from the first pass handed out, as a pool's
+      start_ = Clock::now();
+      started_ = true;
+    }
+    if (next_ >= total_) return false;
+    if (seconds_ > 0.0 && std::chrono::duration<double>(Clock::now() - start_).count() >= seconds_) return false;
+    pass = next_++;
+    return true;
+  }
+
+  std::mutex mutex_;
+  const uint32_t total_;
+  const double seconds_;
+  uint32_t next_ = 0;
+  bool started_ = false;
+  Clock::time_point start_;
+};
+
+// Another rank's ledger: each pass is a question to rank 0.
+class RemoteLedger : public PassLedger {
+ public:
+  explicit RemoteLedger(int rank) : rank_(rank) {}
+
+  bool next(uint32_t& pass) override {
+    slowDownIfAsked(rank_);
+    int64_t message = 0, reply = -1;
+    MPI_Send(&message, 1, MPI_INT64_T, 0, kTagRequest, MPI_COMM_WORLD);
+    MPI_Recv(&reply, 1, MPI_INT64_T, 0, kTagPass, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    bytes += sizeof message;
+    if (reply < 0) return false;
+    pass = uint32_t(reply);
+    return true;
+  }
+
+  void bye() {
+    int64_t message = 0;
+    MPI_Send(&message, 1, MPI_INT64_T, 0, kTagBye, MPI_COMM_WORLD);
+    bytes += sizeof message;
+  }
+
+  uint64_t bytes = 0;  // sent: the requests
+
+ private:
+  int rank_;
+};
+
+// Sums every rank's film onto rank 0's (in place there). Returns the bytes this rank sent.
+uint64_t reduceFilm(Film& film, int rank) {
+  uint64_t bytes = 0;
+  for (std::vector<double>* v : {&film.sum, &film.sumSq, &film.aovSum, &film.oddSum}) {
+    if (v->empty()) continue;
+    MPI_Reduce(rank == 0 ? MPI_IN_PLACE : v->data(), v->data(), int(v->size()), MPI_DOUBLE, MPI_SUM, 0,
+               MPI_COMM_WORLD);
+    if (rank != 0) bytes += v->size() * sizeof(double);  // the root receives
+  }
+  uint64_t passes = film.passes(), total = 0;
+  MPI_Reduce(&passes, &total, 1, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD);
+  if (rank == 0) film.resumeAt(total);
+  return bytes;
+}
+
+// Every rank's share, gathered on rank 0: passes, busy seconds, when it finished, bytes
+// sent and the devices that rendered.
+void gatherShares(const MpiSession& mpi, RenderResult& r, uint64_t passes, double seconds, uint64_t bytes) {
+  constexpr int kNameBytes = 256;
+  const double mine[4] = {double(passes), seconds, MPI_Wtime(), double(bytes)};
+  char devices[kNameBytes] = {};
+  std::strncpy(devices, r.stats.contributors().c_str(), kNameBytes - 1);
+  std::vector<double> all(size_t(4 * mpi.size()));
+  std::vector<char> names(size_t(kNameBytes * mpi.size()));
+  MPI_Gather(mine, 4, MPI_DOUBLE, all.data(), 4, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  MPI_Gather(devices, kNameBytes, MPI_CHAR, names.data(), kNameBytes, MPI_CHAR, 0, MPI_COMM_WORLD);
+  if (mpi.rank() != 0) return;
+  double lastEnd = 0.0;
+  for (int k = 0; k < mpi.size(); ++k) lastEnd = std::max(lastEnd, all[size_t(4 * k + 2)]);
+  for (int k = 0; k < mpi.size(); ++k) {
+    RenderStats::RankShare share;
+    share.rank = k;
+    share.passes = uint64_t(all[size_t(4 * k)]);
+    share.seconds = all[size_t(4 * k + 1)];
+    share.idleSeconds = lastEnd - all[size_t(4 * k + 2)];
+    share.bytesSent = uint64_t(all[size_t(4 * k + 3)]);
+    share.devices = std::string(&names[size_t(kNameBytes * k)]);
+    r.stats.ranks.push_back(share);
+  }
+}
+
+}  // namespace
+
+bool startedByMpirun() {
+  const char* size = std::getenv("OMPI_COMM_WORLD_SIZE");
+  return size && *size;
+}
+
+MpiSession::MpiSession(int* argc, char*** argv) {
+  // Worker threads ask for passes (one at a time, under the pool's lock), and rank 0's
+  // server thread answers while its main thread renders: calls come from several threads.
+  int provided = 0;
+  MPI_Init_thread(argc, argv, MPI_THREAD_MULTIPLE, &provided);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &size_);
+}
+
+MpiSession::~MpiSession() { MPI_Finalize(); }
+
+void MpiSession::abort(int code) const {
+  MPI_Abort(MPI_COMM_WORLD, code);
+  std::exit(code);
+}
+
+RenderResult renderAcrossRanks(const MpiSession& mpi, const std::vector<DeviceInfo>& devices, const Scene& scene,
+                               const Bvh& bvh, const Camera& camera, RenderSettings settings) {
+  RootLedger root(uint32_t(std::max(1, settings.spp)), settings.seconds);
+  RemoteLedger remote(mpi.rank());
+  settings.ledger = mpi.rank() == 0 ? static_cast<PassLedger*>(&root) : &remote;
+  std::thread server;
+  if (mpi.rank() == 0) server = std::thread([&] { root.serve(mpi.size()); });
+  const double start = MPI_Wtime();
+  RenderResult r = render(devices, scene, bvh, camera, settings);
+  const double seconds = MPI_Wtime() - start;
+  if (mpi.rank() == 0) server.join();
+  else remote.bye();
+
+  const uint64_t passes = r.film.passes();
+  const uint64_t bytes = reduceFilm(r.film, mpi.rank()) + (mpi.rank() == 0 ? root.bytes : remote.bytes);
+  gatherShares(mpi, r, passes, seconds, bytes);
+  int complete = r.complete ? 1 : 0, allComplete = 0;
+  MPI_Reduce(&complete, &allComplete, 1, MPI_INT, MPI_MIN, 0, MPI_COMM_WORLD);
+  uint64_t counts[4] = {r.stats.cameraRays, r.stats.bounceRays, r.stats.shadowRays, r.stats.nonfinite}, sums[4] = {};
+  MPI_Reduce(counts, sums, 4, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD);
+  double slowest = 0.0;
+  MPI_Reduce(&r.stats.seconds, &slowest, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+  if (mpi.rank() != 0) return RenderResult{};
+  r.complete = allComplete == 1;
+  r.stats.cameraRays = sums[0];
+  r.stats.bounceRays = sums[1];
+  r.stats.shadowRays = sums[2];
+  r.stats.nonfinite = sums[3];
+  r.stats.samples = r.film.passes() * r.film.pixels();
+  r.stats.seconds = slowest;
+  return r;
+}
+
+}  // namespace fh
