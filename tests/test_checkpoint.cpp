@@ -194,7 +194,7 @@ TEST(Chunks, OverlapsOtherRendersGapsAndBadFlagsAreCaught) {
     std::string args, message;
   };
   for (const Case& c : std::vector<Case>{
-           {"merge " + dir + "/p0.film " + dir + "/p2.film -o " + dir + "/x.exr", "share passes"},
+           {"merge " + dir + "/p0.film " + dir + "/p2.film -o " + dir + "/x.exr", "shares passes"},
            {"merge " + dir + "/p0.film " + dir + "/other.film -o " + dir + "/x.exr", "a chunk of another render"},
            {"merge " + dir + "/p0.film " + dir + "/missing.film -o " + dir + "/x.exr", "cannot read"},
            {"merge " + dir + "/p0.film", "--output is required"},
@@ -205,7 +205,7 @@ TEST(Chunks, OverlapsOtherRendersGapsAndBadFlagsAreCaught) {
            {render + "--passes 0:4 --film " + dir + "/e.film --noise 1e-2", "does not go with --noise"},
            {render + "--passes 0:4 --film " + dir + "/e.film --checkpoint " + dir + "/c.fhc", "--checkpoint"},
            {render + "--passes 0:4 --film " + dir + "/p0.film", "file exists"},
-           {render + "--spp 9 --resume " + dir + "/p6.film -o " + dir + "/x.exr", "a chunk of passes 6:9"}}) {
+           {render + "--spp 9 --resume " + dir + "/p6.film -o " + dir + "/x.exr", "holds passes 6:9, not a checkpoint"}}) {
     const auto r = test::runFredholm(c.args);
     EXPECT_NE(r.exitCode, 0) << c.args;
     EXPECT_NE(r.output.find(c.message), std::string::npos) << c.args << "\n" << r.output;

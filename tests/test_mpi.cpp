@@ -5,9 +5,11 @@
 // mechanism; one PoCL thread per rank keeps the ranks from oversubscribing two cores.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <string>
 
 #include "image/image_io.h"
+#include "render/checkpoint.h"
 #include "test_support.h"
 
 namespace fh {
@@ -21,6 +23,11 @@ const std::string kMpiEnvironment =
 test::CommandResult mpirun(int ranks, const std::string& args, const std::string& environment = "") {
   return test::runCommand(kMpiEnvironment + " " + environment + " timeout 300 mpirun --oversubscribe --bind-to none -np " +
                           std::to_string(ranks) + " " + FREDHOLM_BINARY + " " + args);
+}
+
+// The fingerprint the ranks' checkpoints at `base` were saved with.
+std::string savedFingerprint(const std::string& base) {
+  return readFilm(rankCheckpointPath(base, 0), "test").fingerprint;
 }
 
 const std::string kRender = "render --width 24 --height 16 --seed 4 --aovs albedo,depth --force ";
@@ -55,6 +62,33 @@ TEST(Mpi, ASlowedRankTakesFewerPasses) {
   EXPECT_EQ(fast + slow, 32u);
   EXPECT_LT(slow, fast) << json.dump(2);
   EXPECT_GT(json["ranks"][1]["bytes_sent"].get<uint64_t>(), 0u);
+}
+
+// Open MPI 4.1 ends the job when a rank dies. Every rank checkpoints its own film; rank 1
+// kills itself (SIGKILL) once three of its passes are saved, and the job is rerun with
+// --resume on another rank count: it renders only the passes no checkpoint holds (those in
+// flight were lost) and gives the image of one uninterrupted process.
+TEST(Mpi, AKilledRankIsRecoveredFromTheRanksCheckpoints) {
+  const std::string dir = test::tempDir("mpi-killed");
+  const std::string args = "render --width 48 --height 32 --seed 6 --spp 40 --force ";
+  ASSERT_EQ(test::runFredholm(args + "-o " + dir + "/alone.exr").exitCode, 0);
+  const std::string ckpt = dir + "/ck", out = dir + "/out.exr";
+  const std::string each = std::string(FREDHOLM_BINARY) + " " + args + "--checkpoint " + ckpt +
+                           " --checkpoint-every 0 -o " + out;
+  // Rank 0 is slowed so that rank 1 takes passes enough to die after three.
+  const auto killed = test::runCommand(kMpiEnvironment + " FREDHOLM_SLOW_RANK=0 timeout 300 mpirun --oversubscribe "
+                                       "--bind-to none -np 1 " + each + " : -np 1 env FREDHOLM_KILL_AFTER_PASSES=3 " +
+                                       each);
+  EXPECT_NE(killed.exitCode, 0) << killed.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  ASSERT_EQ(rankCheckpointFiles(ckpt).size(), 2u) << killed.output;
+  const auto resumed = mpirun(3, args + "--resume " + ckpt + " --checkpoint " + ckpt + " -o " + out);
+  ASSERT_EQ(resumed.exitCode, 0) << resumed.output;
+  EXPECT_TRUE(readImage(out).rgb == readImage(dir + "/alone.exr").rgb);
+  // The checkpoints left hold every pass once.
+  const std::string fingerprint = savedFingerprint(ckpt);
+  const Film all = loadRankCheckpoints(ckpt, fingerprint, "--resume");
+  EXPECT_EQ(all.describePasses(), "0:40");
 }
 
 TEST(Mpi, WhatRanksCannotShareIsAOneLineErrorThatEndsTheJob) {

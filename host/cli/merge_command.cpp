@@ -17,13 +17,10 @@ namespace {
 struct Part {
   std::string path;
   SavedFilm saved;
-  uint64_t first() const { return saved.film.firstPass(); }
-  uint64_t end() const { return saved.film.firstPass() + saved.film.passes(); }
-  std::string range() const { return std::to_string(first()) + ":" + std::to_string(end()); }
 };
 
-// The parts, read and ordered by first pass; throws fh::Error for a part of another render
-// (or size, or layers) than the first, or two that share passes.
+// The parts, read; throws fh::Error for a part of another render (or size, or layers) than
+// the first.
 std::vector<Part> readParts(const std::vector<std::string>& paths) {
   std::vector<Part> parts;
   for (const std::string& path : paths) parts.push_back({path, readFilm(path, "merge")});
@@ -35,22 +32,34 @@ std::vector<Part> readParts(const std::vector<std::string>& paths) {
       throw Error("merge: '" + p.path + "' is a chunk of another render than '" + reference.path +
                   "' (another scene, camera or settings: size, seed, method, depths, environment, filter, --aovs)");
   }
-  std::sort(parts.begin(), parts.end(), [](const Part& a, const Part& b) { return a.first() < b.first(); });
-  for (size_t i = 1; i < parts.size(); ++i)
-    if (parts[i].first() < parts[i - 1].end())
-      throw Error("merge: '" + parts[i - 1].path + "' (passes " + parts[i - 1].range() + ") and '" + parts[i].path +
-                  "' (passes " + parts[i].range() + ") share passes; each pass may be merged once");
+  std::sort(parts.begin(), parts.end(),
+            [](const Part& a, const Part& b) { return a.saved.film.firstPass() < b.saved.film.firstPass(); });
   return parts;
 }
 
-// The passes no part holds, between 0 and the last part's end ("" if none).
-std::string missingPasses(const std::vector<Part>& parts) {
+// The parts added into one film; throws fh::Error naming a part that shares passes with
+// those before it.
+Film mergeParts(const std::vector<Part>& parts) {
+  Film film = parts.front().saved.film;
+  for (size_t i = 1; i < parts.size(); ++i) {
+    try {
+      film.merge(parts[i].saved.film);
+    } catch (const Error&) {
+      throw Error("merge: '" + parts[i].path + "' (passes " + parts[i].saved.film.describePasses() +
+                  ") shares passes with the parts before it (" + film.describePasses() +
+                  "); each pass may be merged once");
+    }
+  }
+  return film;
+}
+
+// The passes no part holds, from 0 to the last one held ("" if none).
+std::string missingPasses(const Film& film) {
   std::string missing;
   uint64_t next = 0;
-  for (const Part& p : parts) {
-    if (p.first() > next)
-      missing += (missing.empty() ? "" : ", ") + std::to_string(next) + ":" + std::to_string(p.first());
-    next = p.end();
+  for (const auto& [begin, end] : film.passRanges()) {
+    if (begin > next) missing += (missing.empty() ? "" : ", ") + std::to_string(next) + ":" + std::to_string(begin);
+    next = end;
   }
   return missing;
 }
@@ -63,16 +72,15 @@ int runMerge(const MergeOptions& o) {
   if (!layers.empty() && extensionOf(o.output) != ".exr")
     throw Error("--aovs: layers are written into one EXR; -o '" + o.output + "' is not an .exr file");
   const std::vector<Part> parts = readParts(o.parts);
-  Film film = parts.front().saved.film;
-  for (size_t i = 1; i < parts.size(); ++i) film.merge(parts[i].saved.film);
+  const Film film = mergeParts(parts);
   for (const std::string& layer : layers)
     if (isSurfaceAov(layer) && !film.hasSurfaceAovs())
       throw Error("--aovs " + layer + ": the chunks were rendered without it (render them with --aovs " + layer + ")");
-  const std::string missing = missingPasses(parts);
+  const std::string missing = missingPasses(film);
   if (!missing.empty())
-    std::cerr << "fredholm: warning: no part holds passes " << missing << ": the image has "
-              << film.passes() << " samples per pixel, not the " << parts.back().end()
-              << " of one render of passes 0:" << parts.back().end() << "\n";
+    std::cerr << "fredholm: warning: no part holds passes " << missing << ": the image has " << film.passes()
+              << " samples per pixel, not the " << film.nextPass() << " of one render of passes 0:"
+              << film.nextPass() << "\n";
   std::map<std::string, std::string> metadata = {{"spp", std::to_string(film.passes())},
                                                  {"merged_parts", std::to_string(parts.size())},
                                                  {"fingerprint", parts.front().saved.fingerprint}};

@@ -2,6 +2,7 @@
 // every device --device selects, and the image with its metadata.
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -177,7 +178,7 @@ void reportDevices(const RenderResult& r) {
 
 // The --aovs layers, parsed and checked against the other flags and the output; picks the
 // default output name (PNG, or EXR with layers) and checks every output file before work.
-std::vector<std::string> checkOutputs(RenderOptions& o, RenderSettings& settings, bool writes) {
+std::vector<std::string> checkOutputs(RenderOptions& o, RenderSettings& settings, int rank) {
   const std::vector<std::string> layers = o.aovs.empty() ? std::vector<std::string>{} : parseAovLayers(o.aovs);
   if (!o.aov.empty() && !layers.empty()) throw Error("--aov (a debug view) and --aovs (layers beside the image): pick one");
   for (const auto& layer : layers) settings.surfaceAovs |= isSurfaceAov(layer);
@@ -185,19 +186,21 @@ std::vector<std::string> checkOutputs(RenderOptions& o, RenderSettings& settings
   // With --film the film is the output, and an image is written only where -o asks.
   if (o.output.empty() && o.film.empty()) o.output = firstFreeName(layers.empty() ? "fredholm.png" : "fredholm.exr");
   if (!o.film.empty() && !o.aov.empty()) throw Error("--film saves a render's passes; --aov renders none");
-  if (!writes) return layers;  // another rank than the one that writes
+  if (!std::isfinite(o.checkpointEvery) || o.checkpointEvery < 0)
+    throw Error("--checkpoint-every must be a finite number of seconds, 0 or more");
+  settings.checkpointSeconds = o.checkpointEvery;
+  // Under mpirun every rank saves its own film, FILE.rank<r>. The checkpoint a render
+  // resumes from is its own to overwrite.
+  if (!o.checkpoint.empty()) {
+    settings.checkpointPath = o.mpi ? rankCheckpointPath(o.checkpoint, rank) : o.checkpoint;
+    if (o.checkpoint != o.resume) checkOutputFile(settings.checkpointPath, o.force, "--checkpoint");
+  }
+  if (rank != 0) return layers;  // rank 0 writes the image and the rest
   if (!o.film.empty()) checkOutputFile(o.film, o.force, "--film");
   if (!o.output.empty()) checkOutputPath(o.output, o.force);
   if (!layers.empty() && !o.output.empty() && extensionOf(o.output) != ".exr")
     throw Error("--aovs: layers are written into one EXR; -o '" + o.output + "' is not an .exr file");
   if (!o.statsFile.empty()) checkOutputFile(o.statsFile, o.force, "--stats");
-  // The checkpoint a render resumes from is its own to overwrite.
-  if (!o.checkpoint.empty() && o.checkpoint != o.resume) checkOutputFile(o.checkpoint, o.force, "--checkpoint");
-  if (!std::isfinite(o.checkpointEvery) || o.checkpointEvery < 0)
-    throw Error("--checkpoint-every must be a finite number of seconds, 0 or more");
-  settings.checkpointPath = o.checkpoint;
-  settings.filmPath = o.film;
-  settings.checkpointSeconds = o.checkpointEvery;
   return layers;
 }
 
@@ -213,10 +216,25 @@ int mpiRank(const RenderOptions& o) {
 // Under mpirun: what a render shared by ranks cannot do (yet), refused on every rank alike;
 // and no progress bars (every rank's stderr reaches the terminal).
 void checkSharedRender(const RenderOptions& o, RenderSettings& settings) {
-  const char* clash = o.noise > 0 ? "--noise" : !o.checkpoint.empty() ? "--checkpoint" : !o.resume.empty() ? "--resume"
-                      : !o.aov.empty() ? "--aov" : nullptr;
+  const char* clash = o.noise > 0 ? "--noise" : !o.aov.empty() ? "--aov" : nullptr;
   if (clash) throw Error(std::string("under mpirun, ranks share a render without ") + clash + " (not yet supported)");
   settings.progress = false;
+}
+
+// Under mpirun, --resume FILE: rank 0 starts from every rank's checkpoint (FILE.rank<r>,
+// whatever the rank count that wrote them) added into one film; the others start empty.
+// Where the render checkpoints to the same FILE, rank 0 saves that film as its own
+// checkpoint and removes the other ranks' files it holds, before any rank renders (the
+// ranks ask rank 0 for passes first), so no pass is ever in two of them.
+std::shared_ptr<const Film> resumeRanks(const RenderOptions& o, int rank, const std::string& fingerprint) {
+  if (rank != 0) return nullptr;
+  auto film = std::make_shared<Film>(loadRankCheckpoints(o.resume, fingerprint, "--resume"));
+  if (o.checkpoint == o.resume) {
+    saveCheckpoint(rankCheckpointPath(o.checkpoint, 0), *film, fingerprint);
+    for (const std::string& file : rankCheckpointFiles(o.checkpoint))
+      if (file != rankCheckpointPath(o.checkpoint, 0)) std::filesystem::remove(file);
+  }
+  return film;
 }
 
 RenderResult renderOnEveryRank(const RenderOptions& o, const std::vector<DeviceInfo>& devices, const Scene& scene,
@@ -238,8 +256,7 @@ std::string writeOutputs(const RenderOptions& o, const RenderSettings& s, const 
   }
   if (!o.film.empty() && film.passes() > 0) {
     saveFilm(o.film, film, s.fingerprint, "--film");
-    written += (written.empty() ? "" : " and ") + o.film + " (passes " + std::to_string(film.firstPass()) + ":" +
-               std::to_string(film.firstPass() + film.passes()) + ")";
+    written += (written.empty() ? "" : " and ") + o.film + " (passes " + film.describePasses() + ")";
   }
   return written;
 }
@@ -286,7 +303,7 @@ int runRender(RenderOptions o) {
   const Aov aov = debugView ? parseAov(o.aov) : Aov::Albedo;
   const int rank = mpiRank(o);
   if (o.mpi) checkSharedRender(o, settings);
-  const std::vector<std::string> layers = checkOutputs(o, settings, rank == 0);
+  const std::vector<std::string> layers = checkOutputs(o, settings, rank);
   const auto devices = selectDevices(listDevices(), o.device);
   if (debugView && devices.size() > 1)
     throw Error("--aov renders on one device, and --device '" + o.device + "' selects " +
@@ -299,7 +316,8 @@ int runRender(RenderOptions o) {
   settings.fingerprint = renderFingerprint(scene, camera, settings);
   if (!o.resume.empty()) {
     if (debugView) throw Error("--resume goes on with a render's passes; --aov renders none");
-    settings.resume = std::make_shared<Film>(loadCheckpoint(o.resume, settings.fingerprint, "--resume"));
+    settings.resume = o.mpi ? resumeRanks(o, rank, settings.fingerprint)
+                            : std::make_shared<Film>(loadCheckpoint(o.resume, settings.fingerprint, "--resume"));
   }
   const auto start = std::chrono::steady_clock::now();
   const Bvh bvh = buildBvh(scene);

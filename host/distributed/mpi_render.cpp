@@ -32,7 +32,8 @@ void slowDownIfAsked(int rank) {
 // on the server thread, for every other rank's requests.
 class RootLedger : public PassLedger {
  public:
-  RootLedger(uint32_t total, double seconds) : total_(total), seconds_(seconds) {}
+  // `done`: passes a resumed film holds already (none if null), never handed out again.
+  RootLedger(uint32_t total, double seconds, const Film* done) : total_(total), seconds_(seconds), done_(done) {}
 
   bool next(uint32_t& pass) override {
     slowDownIfAsked(0);
@@ -64,6 +65,7 @@ class RootLedger : public PassLedger {
       start_ = Clock::now();
       started_ = true;
     }
+    while (done_ && next_ < total_ && done_->holds(next_)) ++next_;
     if (next_ >= total_) return false;
     if (seconds_ > 0.0 && std::chrono::duration<double>(Clock::now() - start_).count() >= seconds_) return false;
     pass = next_++;
@@ -73,6 +75,7 @@ class RootLedger : public PassLedger {
   std::mutex mutex_;
   const uint32_t total_;
   const double seconds_;
+  const Film* done_;
   uint32_t next_ = 0;
   bool started_ = false;
   Clock::time_point start_;
@@ -115,9 +118,21 @@ uint64_t reduceFilm(Film& film, int rank) {
                MPI_COMM_WORLD);
     if (rank != 0) bytes += v->size() * sizeof(double);  // the root receives
   }
-  uint64_t passes = film.passes(), total = 0;
-  MPI_Reduce(&passes, &total, 1, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD);
-  if (rank == 0) film.resumeAt(total);
+  // Which passes the sums hold: every rank's ranges, gathered.
+  std::vector<uint64_t> mine;
+  for (const auto& [begin, end] : film.passRanges()) mine.insert(mine.end(), {begin, end});
+  int count = int(mine.size()), ranks = 0;
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  std::vector<int> counts(static_cast<size_t>(ranks)), offsets(static_cast<size_t>(ranks));
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+  for (size_t k = 1; k < counts.size(); ++k) offsets[k] = offsets[k - 1] + counts[k - 1];
+  std::vector<uint64_t> all(size_t(offsets.back() + counts.back()));
+  MPI_Gatherv(mine.data(), count, MPI_UINT64_T, all.data(), counts.data(), offsets.data(), MPI_UINT64_T, 0,
+              MPI_COMM_WORLD);
+  if (rank != 0) return bytes + mine.size() * sizeof(uint64_t);
+  Film::PassRanges ranges;
+  for (size_t i = 0; i + 1 < all.size(); i += 2) ranges.emplace_back(all[i], all[i + 1]);
+  film.setPassRanges(ranges);
   return bytes;
 }
 
@@ -172,7 +187,7 @@ void MpiSession::abort(int code) const {
 
 RenderResult renderAcrossRanks(const MpiSession& mpi, const std::vector<DeviceInfo>& devices, const Scene& scene,
                                const Bvh& bvh, const Camera& camera, RenderSettings settings) {
-  RootLedger root(uint32_t(std::max(1, settings.spp)), settings.seconds);
+  RootLedger root(uint32_t(std::max(1, settings.spp)), settings.seconds, settings.resume.get());
   RemoteLedger remote(mpi.rank());
   settings.ledger = mpi.rank() == 0 ? static_cast<PassLedger*>(&root) : &remote;
   std::thread server;

@@ -4,8 +4,10 @@
 // local devices use (render/pass_pool.h), and the ranks' films are summed onto rank 0 with
 // MPI_Reduce. Film sums are exact (render/film.h), so the sum is the same bits in any
 // reduction order: the image does not depend on how many ranks there were or which
-// rendered what. Debian's Open MPI 4.1 aborts the job when a rank dies; a lost rank's
-// passes are not rendered again (see README).
+// rendered what. Debian's Open MPI 4.1 aborts the job when a rank dies: with --checkpoint
+// every rank saves its own film (FILE.rank<r>, render/checkpoint.h), and a rerun with
+// --resume FILE (any rank count) starts rank 0 from them all and hands out only the passes
+// none holds, which completes the same image.
 #pragma once
 #include <memory>
 #include <vector>
@@ -39,8 +41,9 @@ class MpiSession {
   int rank_ = 0, size_ = 1;
 };
 
-// One render over every rank of `mpi`, each rendering on `devices` (its own). On rank 0 the
-// result holds the whole film, the totals and stats.ranks; on the others, an empty film.
+// One render over every rank of `mpi`, each rendering on `devices` (its own); on rank 0,
+// settings.resume may hold passes done already. On rank 0 the result holds the whole film,
+// the totals and stats.ranks; on the others, an empty film.
 // FREDHOLM_SLOW_RANK=r (tests): rank r waits 200 ms before asking for each pass.
 RenderResult renderAcrossRanks(const MpiSession& mpi, const std::vector<DeviceInfo>& devices, const Scene& scene,
                                const Bvh& bvh, const Camera& camera, RenderSettings settings);

@@ -2,7 +2,9 @@
 // sums follow), then the film's sums as raw doubles, in the order Film declares them.
 #include "render/checkpoint.h"
 
+#include <algorithm>
 #include <cstdint>
+#include <filesystem>
 #include <cstring>
 #include <fstream>
 #include <iomanip>
@@ -15,7 +17,8 @@
 namespace fh {
 namespace {
 
-// Version 2: the header names the film's first pass (chunks), and samples are quantized.
+// Version 2: the header lists the passes the film holds (chunks, ranks' films), and samples
+// are quantized (render/film.h).
 constexpr const char* kMagic = "fredholm-film-2";
 
 // FNV-1a, 64 bits, over whatever bytes are fed to it.
@@ -71,8 +74,9 @@ std::string renderFingerprint(const Scene& scene, const Camera& camera, const Re
 
 void saveFilm(const std::string& path, const Film& film, const std::string& fingerprint, const std::string& flag) {
   std::ostringstream out;
-  out << kMagic << ' ' << fingerprint << ' ' << film.width << ' ' << film.height << ' ' << film.firstPass() << ' '
-      << film.passes() << ' ' << film.aovSum.size() << ' ' << film.oddSum.size() << '\n';
+  out << kMagic << ' ' << fingerprint << ' ' << film.width << ' ' << film.height << ' ' << film.passRanges().size();
+  for (const auto& [begin, end] : film.passRanges()) out << ' ' << begin << ' ' << end;
+  out << ' ' << film.aovSum.size() << ' ' << film.oddSum.size() << '\n';
   for (const std::vector<double>* v : sums(film))
     out.write(reinterpret_cast<const char*>(v->data()), std::streamsize(v->size() * 8));
   writeTextAtomically(path, flag, out.str());
@@ -87,13 +91,23 @@ SavedFilm readFilm(const std::string& path, const std::string& flag) {
   if (!in) throw Error(flag + " '" + path + "': cannot read the file");
   std::string magic, saved;
   int width = 0, height = 0;
-  uint64_t first = 0, passes = 0;
-  size_t aovs = 0, odd = 0;
-  in >> magic >> saved >> width >> height >> first >> passes >> aovs >> odd;
-  if (!in || magic != kMagic || in.get() != '\n' || width <= 0 || height <= 0 ||
-      uint64_t(width) * uint64_t(height) > (uint64_t(1) << 28) || first >= (uint64_t(1) << 32) ||
-      passes > (uint64_t(1) << 32))
-    throw Error(flag + " '" + path + "': not a fredholm film or checkpoint");
+  size_t rangeCount = 0, aovs = 0, odd = 0;
+  const std::string notAFilm = flag + " '" + path + "': not a fredholm film or checkpoint";
+  in >> magic >> saved >> width >> height >> rangeCount;
+  if (!in || magic != kMagic || rangeCount > 4096) throw Error(notAFilm);
+  // Passes are numbered in 32 bits; the ranges ascend without touching.
+  Film::PassRanges ranges(rangeCount);
+  uint64_t passes = 0;
+  for (size_t i = 0; i < rangeCount; ++i) {
+    in >> ranges[i].first >> ranges[i].second;
+    if (!in || ranges[i].first >= ranges[i].second || ranges[i].second > (uint64_t(1) << 32) ||
+        (i > 0 && ranges[i].first <= ranges[i - 1].second))
+      throw Error(notAFilm);
+    passes += ranges[i].second - ranges[i].first;
+  }
+  in >> aovs >> odd;
+  if (!in || in.get() != '\n' || width <= 0 || height <= 0 || uint64_t(width) * uint64_t(height) > (uint64_t(1) << 28))
+    throw Error(notAFilm);
   // The sums' sizes follow from the header: checked against the file before allocating.
   const uint64_t pixels = uint64_t(width) * uint64_t(height);
   if ((aovs != 0 && aovs != pixels * kAovSumsPerPixel) || (odd != 0 && odd != pixels * 3))
@@ -103,7 +117,7 @@ SavedFilm readFilm(const std::string& path, const std::string& flag) {
   const uint64_t bytes = uint64_t(in.tellg() - body);
   in.seekg(body);
   if (bytes != (8 * pixels + aovs + odd) * 8) throw Error(flag + " '" + path + "': the file is cut short");
-  SavedFilm f{Film(width, height, aovs > 0, odd > 0, first), saved};
+  SavedFilm f{Film(width, height, aovs > 0, odd > 0, ranges.empty() ? 0 : ranges.front().first), saved};
   for (std::vector<double>* v : sums(f.film))
     if (!in.read(reinterpret_cast<char*>(v->data()), std::streamsize(v->size() * 8)))
       throw Error(flag + " '" + path + "': the file is cut short");
@@ -112,7 +126,7 @@ SavedFilm readFilm(const std::string& path, const std::string& flag) {
   // Every pass adds one sample to every pixel.
   for (size_t p = 0; p < f.film.pixels(); ++p)
     if (f.film.count(p) != double(passes)) throw Error(flag + " '" + path + "': the film's sample counts do not add up");
-  f.film.resumeAt(passes);
+  f.film.setPassRanges(ranges);
   return f;
 }
 
@@ -121,11 +135,52 @@ Film loadCheckpoint(const std::string& path, const std::string& fingerprint, con
   if (f.fingerprint != fingerprint)
     throw Error(flag + " '" + path + "': saved by a render of another scene, camera or settings (size, seed, "
                 "method, depths, environment, filter, --noise, --aovs); resume with the same ones");
-  if (f.film.firstPass() != 0)
-    throw Error(flag + " '" + path + "': a chunk of passes " + std::to_string(f.film.firstPass()) + ":" +
-                std::to_string(f.film.firstPass() + f.film.passes()) + ", not a checkpoint; merge chunks with "
-                "fredholm merge");
+  if (f.film.firstPass() != 0 || !f.film.consecutive())
+    throw Error(flag + " '" + path + "': holds passes " + f.film.describePasses() +
+                ", not a checkpoint of passes from 0 on; merge chunks with fredholm merge");
   return std::move(f.film);
+}
+
+std::string rankCheckpointPath(const std::string& base, int rank) { return base + ".rank" + std::to_string(rank); }
+
+std::vector<std::string> rankCheckpointFiles(const std::string& base) {
+  namespace fs = std::filesystem;
+  const fs::path path(base);
+  const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  const std::string prefix = path.filename().string() + ".rank";
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() > prefix.size() && name.compare(0, prefix.size(), prefix) == 0 &&
+        name.find_first_not_of("0123456789", prefix.size()) == std::string::npos)
+      files.push_back((dir / name).string());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+Film loadRankCheckpoints(const std::string& base, const std::string& fingerprint, const std::string& flag) {
+  const std::vector<std::string> files = rankCheckpointFiles(base);
+  if (files.empty()) throw Error(flag + " '" + base + "': no checkpoint of ranks there (" + base + ".rank0, ...)");
+  Film film;
+  for (size_t i = 0; i < files.size(); ++i) {
+    SavedFilm f = readFilm(files[i], flag);
+    if (f.fingerprint != fingerprint)
+      throw Error(flag + " '" + files[i] + "': saved by a render of another scene, camera or settings; resume with "
+                  "the same ones");
+    if (i == 0) {
+      film = std::move(f.film);
+      continue;
+    }
+    try {
+      film.merge(f.film);
+    } catch (const Error&) {
+      throw Error(flag + " '" + files[i] + "': shares passes with the other ranks' checkpoints (" +
+                  film.describePasses() + "); remove the stale one");
+    }
+  }
+  return film;
 }
 
 }  // namespace fh

@@ -4,6 +4,7 @@
 // point and resumed gives the same image, to the bit, as one never interrupted.
 #pragma once
 #include <string>
+#include <vector>
 
 #include "render/film.h"
 #include "render/settings.h"
@@ -37,5 +38,13 @@ SavedFilm readFilm(const std::string& path, const std::string& flag);
 // be read, is cut short, was saved by another render (another fingerprint), or is a chunk
 // that does not start at pass 0.
 Film loadCheckpoint(const std::string& path, const std::string& fingerprint, const std::string& flag);
+
+// Ranks sharing a render (host/distributed) checkpoint to a file each: `base`.rank<r>.
+std::string rankCheckpointPath(const std::string& base, int rank);
+// The files `base`.rank<r> there are, whatever the rank count that wrote them.
+std::vector<std::string> rankCheckpointFiles(const std::string& base);
+// Their films added into one (each may hold any passes); throws fh::Error naming `flag`
+// for none found, another render's file, or two that share passes.
+Film loadRankCheckpoints(const std::string& base, const std::string& fingerprint, const std::string& flag);
 
 }  // namespace fh

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "base/error.h"
 #include "image/error_metrics.h"
 
 namespace fh {
@@ -25,24 +26,58 @@ Film::Film(int w, int h, bool surfaceAovs, bool twoReplicates, uint64_t firstPas
       firstPass_(firstPass) {}
 
 void Film::merge(const Film& other) {
+  PassRanges ranges = held_;
+  ranges.insert(ranges.end(), other.held_.begin(), other.held_.end());
+  std::sort(ranges.begin(), ranges.end());
+  for (size_t i = 1; i < ranges.size(); ++i)
+    if (ranges[i].first < ranges[i - 1].second)
+      throw Error("films that share passes (" + std::to_string(ranges[i].first) + ":" +
+                  std::to_string(std::min(ranges[i].second, ranges[i - 1].second)) + ") cannot be merged");
   addEach(sum, other.sum);
   addEach(sumSq, other.sumSq);
   addEach(aovSum, other.aovSum);
   addEach(oddSum, other.oddSum);
-  passes_ += other.passes_;
   firstPass_ = std::min(firstPass_, other.firstPass_);
+  setPassRanges(ranges);
 }
 
-void Film::addPass(const std::vector<float>& samples) {
+void Film::setPassRanges(PassRanges ranges) {
+  std::sort(ranges.begin(), ranges.end());
+  held_.clear();
+  passes_ = 0;
+  for (const auto& [begin, end] : ranges) {
+    if (begin >= end) continue;
+    if (!held_.empty() && begin <= held_.back().second) held_.back().second = std::max(held_.back().second, end);
+    else held_.emplace_back(begin, end);
+  }
+  for (const auto& [begin, end] : held_) passes_ += end - begin;
+}
+
+bool Film::holds(uint64_t pass) const {
+  for (const auto& [begin, end] : held_)
+    if (pass >= begin && pass < end) return true;
+  return false;
+}
+
+std::string Film::describePasses() const {
+  std::string d;
+  for (const auto& [begin, end] : held_)
+    d += (d.empty() ? "" : ", ") + std::to_string(begin) + ":" + std::to_string(end);
+  return d.empty() ? "none" : d;
+}
+
+void Film::addPass(uint64_t pass, const std::vector<float>& samples) {
   for (size_t i = 0; i < sum.size(); ++i) {
     const double v = quantized(samples[i]);
     sum[i] += v;
     if (i % 4 != 3) sumSq[i] += v * v;
   }
-  if (!oddSum.empty() && (firstPass_ + passes_) % 2 == 1)
+  if (!oddSum.empty() && pass % 2 == 1)
     for (size_t p = 0; p < pixels(); ++p)
       for (size_t c = 0; c < 3; ++c) oddSum[3 * p + c] += quantized(samples[4 * p + c]);
-  ++passes_;
+  PassRanges ranges = held_;
+  ranges.emplace_back(pass, pass + 1);
+  setPassRanges(std::move(ranges));
   if (!hasSurfaceAovs()) return;
   const float* aovs = samples.data() + sum.size();
   for (size_t p = 0; p < pixels(); ++p) {
@@ -63,7 +98,9 @@ double Film::estimatedRelMse() const {
   const bool replicated = !oddSum.empty() && passes_ >= 2;
   // The mean of nEven and nOdd passes: its variance is D^2 nEven nOdd / n^2 in expectation,
   // D the difference of the halves' means (each half's variance proportional to 1 / count).
-  const double nOdd = double((firstPass_ + passes_) / 2 - firstPass_ / 2), nEven = double(passes_) - nOdd;
+  double nOdd = 0.0;
+  for (const auto& [begin, end] : held_) nOdd += double(end / 2 - begin / 2);  // odd passes in [begin, end)
+  const double nEven = double(passes_) - nOdd;
   double total = 0.0;
   for (size_t p = 0; p < pixels(); ++p) {
     const double n = count(p);

@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "image/image_io.h"
@@ -35,13 +36,24 @@ struct Film {
   // pass the film starts at (a chunk's, --passes A:B; else 0).
   Film(int w, int h, bool surfaceAovs = false, bool twoReplicates = false, uint64_t firstPass = 0);
 
-  // Adds the next pass (firstPass() + passes()): per pixel (rgb, 1), pixel-major, as the
+  // Adds pass `pass` (one the film does not hold): per pixel (rgb, 1), pixel-major, as the
   // device's pass buffer holds it, then, for a film with surface AOVs, kAovFloatsPerPixel
   // per pixel.
-  void addPass(const std::vector<float>& samples);
-  // Adds another film's passes: a chunk of the same render (same size and layers) whose
-  // passes this film lacks; the caller checks which they are. Exact but for sumSq.
+  void addPass(uint64_t pass, const std::vector<float>& samples);
+  // Adds the pass after the last one held (firstPass for an empty film).
+  void addPass(const std::vector<float>& samples) { addPass(nextPass(), samples); }
+  // Adds another film's passes: a chunk of the same render (same size and layers). Exact
+  // but for sumSq. Throws fh::Error if the two hold a pass in common.
   void merge(const Film& other);
+
+  // The passes the film holds, as ascending, disjoint, non-adjacent [begin, end) ranges.
+  using PassRanges = std::vector<std::pair<uint64_t, uint64_t>>;
+  const PassRanges& passRanges() const { return held_; }
+  // For a film read back or summed from others: the passes its sums hold.
+  void setPassRanges(PassRanges ranges);
+  bool holds(uint64_t pass) const;
+  // The ranges as text: "0:5, 8:12" (or "none").
+  std::string describePasses() const;
 
   Image image() const;  // the mean per pixel
   // The image with --aovs layers beside it (albedo, normal, depth, variance, spp, in the
@@ -57,9 +69,11 @@ struct Film {
   // which overstates the error of low-discrepancy samples (they are not independent).
   double estimatedRelMse() const;
   uint64_t passes() const { return passes_; }
-  uint64_t firstPass() const { return firstPass_; }
-  // A film read back from a file holds passes firstPass .. firstPass + passes - 1.
-  void resumeAt(uint64_t passes) { passes_ = passes; }
+  // The first pass held; for an empty film, the first it was made to hold.
+  uint64_t firstPass() const { return held_.empty() ? firstPass_ : held_.front().first; }
+  uint64_t nextPass() const { return held_.empty() ? firstPass_ : held_.back().second; }
+  // Whether the film holds passes firstPass() .. nextPass() - 1 and no others.
+  bool consecutive() const { return held_.size() <= 1; }
   double count(size_t pixel) const { return sum[4 * pixel + 3]; }
   size_t pixels() const { return size_t(width) * size_t(height); }
 
@@ -81,6 +95,7 @@ struct Film {
  private:
   std::vector<float> aovMean(size_t first) const;
   uint64_t firstPass_ = 0, passes_ = 0;
+  PassRanges held_;
 };
 
 // The depth of a pixel where nothing was hit (as Cycles writes its background's).

@@ -24,7 +24,7 @@ PassPool::PassPool(const RenderSettings& s, int workers)
       progress_(s.progress),
       lastCheckpoint_(std::chrono::steady_clock::now()) {
   // A resumed render goes on from the first pass its film lacks; a chunk starts at its first.
-  next_ = nextToMerge_ = uint32_t(film_.firstPass() + film_.passes());
+  next_ = nextToMerge_ = uint32_t(film_.nextPass());
   merged_ = film_.passes();
   // ... unless it met its noise target already (a render that stopped there).
   noiseReached_ = s.resume && s.noise > 0.0 && film_.passes() >= kNoiseMinPasses &&
@@ -119,8 +119,7 @@ Film PassPool::finish(bool& complete) {
   complete = noiseReached_ || (pending_.empty() && requeued_.empty() && !anyOutstanding());
   for (auto& [pass, samples] : pending_) {
     if (noiseReached_) break;  // beyond the pass that met the target
-    if (!settings_.filmPath.empty()) break;  // a film for merging holds consecutive passes
-    film_.addPass(samples);
+    film_.addPass(pass, samples);
     ++merged_;
   }
   pending_.clear();
@@ -147,9 +146,10 @@ void PassPool::mergeInOrder() {
     if (next == pending_.end()) return;  // stopping, and the next pass is not in
     std::vector<float> samples;
     samples.swap(next->second);
+    const uint32_t pass = next->first;
     pending_.erase(next);
     lock.unlock();
-    film_.addPass(samples);
+    film_.addPass(pass, samples);
     const bool check = settings_.noise > 0.0 && film_.passes() >= kNoiseMinPasses;
     const double estimate = check ? film_.estimatedRelMse() : -1.0;
     lock.lock();

@@ -68,10 +68,6 @@ struct RenderSettings {
   // checkpointSeconds and when the render ends, with the render's fingerprint
   // (render/checkpoint.h); empty: none.
   std::string checkpointPath;
-  // --film: the film is saved for fredholm merge (by the command line), so it must hold
-  // passes firstPass .. firstPass + n - 1 and no others: passes finished beyond a gap (a
-  // pass lost to a signal or a failed device) are dropped rather than merged.
-  std::string filmPath;
   double checkpointSeconds = 60.0;
   std::string fingerprint;
   // --resume: a saved film to go on from (it holds passes 0 .. resume->passes() - 1).

@@ -21,9 +21,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   try {
     const fh::SavedFilm saved = fh::readFilm(path, "merge");
+    if (saved.film.count(0) != double(saved.film.passes())) __builtin_trap();
     fh::Film twice = saved.film;
-    twice.merge(saved.film);
-    if (twice.passes() != 2 * saved.film.passes() || twice.count(0) != 2 * saved.film.count(0)) __builtin_trap();
+    bool refused = false;
+    try {
+      twice.merge(saved.film);  // a film shares every pass with itself
+    } catch (const fh::Error&) {
+      refused = true;
+    }
+    if (refused != (saved.film.passes() > 0)) __builtin_trap();
     twice.image();
   } catch (const fh::Error&) {
   }
