@@ -97,6 +97,11 @@ TEST(Mpi, WhatRanksCannotShareIsAOneLineErrorThatEndsTheJob) {
   EXPECT_NE(r.exitCode, 0);
   EXPECT_NE(r.output.find("fredholm: error: under mpirun, ranks share a render without --noise"), std::string::npos)
       << r.output;
+  // Every rank's only device fails: the first error ends the job, nothing waits for ever.
+  const auto failed = mpirun(2, kRender + "--spp 16 -o " + dir + "/f.exr", "FREDHOLM_FAIL_DEVICE=0:0");
+  EXPECT_NE(failed.exitCode, 0);
+  EXPECT_EQ(failed.exitCode == 124, false) << "the job hung";
+  EXPECT_NE(failed.output.find("fredholm: error: "), std::string::npos) << failed.output;
 }
 
 }  // namespace

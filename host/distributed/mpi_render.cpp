@@ -193,7 +193,15 @@ RenderResult renderAcrossRanks(const MpiSession& mpi, const std::vector<DeviceIn
   std::thread server;
   if (mpi.rank() == 0) server = std::thread([&] { root.serve(mpi.size()); });
   const double start = MPI_Wtime();
-  RenderResult r = render(devices, scene, bvh, camera, settings);
+  RenderResult r;
+  try {
+    r = render(devices, scene, bvh, camera, settings);
+  } catch (...) {
+    // The error ends the job (MPI_Abort, cli/main.cpp); the server cannot be joined first,
+    // as it waits for ranks that will never say goodbye.
+    if (server.joinable()) server.detach();
+    throw;
+  }
   const double seconds = MPI_Wtime() - start;
   if (mpi.rank() == 0) server.join();
   else remote.bye();
