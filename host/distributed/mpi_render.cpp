@@ -141,8 +141,14 @@ uint64_t reduceFilm(Film& film, int rank) {
 void gatherShares(const MpiSession& mpi, RenderResult& r, uint64_t passes, double seconds, uint64_t bytes) {
   constexpr int kNameBytes = 256;
   const double mine[4] = {double(passes), seconds, MPI_Wtime(), double(bytes)};
+  // Each device with its passes: "name: 12 passes, other: 3 passes".
+  std::string list;
+  for (const auto& d : r.stats.devices)
+    list += (list.empty() ? "" : ", ") + d.name + ": " +
+            std::to_string(r.film.pixels() ? d.samples / r.film.pixels() : 0) + " passes" +
+            (d.error.empty() ? "" : " (failed)");
   char devices[kNameBytes] = {};
-  std::strncpy(devices, r.stats.contributors().c_str(), kNameBytes - 1);
+  std::strncpy(devices, list.c_str(), kNameBytes - 1);
   std::vector<double> all(size_t(4 * mpi.size()));
   std::vector<char> names(size_t(kNameBytes * mpi.size()));
   MPI_Gather(mine, 4, MPI_DOUBLE, all.data(), 4, MPI_DOUBLE, 0, MPI_COMM_WORLD);
