@@ -91,10 +91,13 @@ void chunkOf(const RenderOptions& o, RenderSettings& s) {
   if (!(in >> first >> colon >> end) || colon != ':' || in >> rest || o.passes[0] == '-' ||
       o.passes.find(":-") != std::string::npos || first >= end || end > 0x7fffffffull)
     throw Error("--passes '" + o.passes + "': give A:B, passes A to B-1 with 0 <= A < B (e.g. 0:64)");
-  const char* clash = o.spp ? "--spp (the chunk's end is its spp)" : o.noise > 0 ? "--noise" : !o.resume.empty() ? "--resume"
-                      : !o.checkpoint.empty() ? "--checkpoint (the chunk is the unit to rerun)" : !o.aov.empty() ? "--aov"
-                                                                                                   : nullptr;
-  if (clash) throw Error("--passes renders a chunk for fredholm merge and does not go with " + std::string(clash));
+  const std::pair<bool, const char*> clashes[] = {{o.spp.has_value(), "--spp (the chunk's end is its spp)"},
+                                                  {o.noise > 0, "--noise"},
+                                                  {!o.resume.empty(), "--resume"},
+                                                  {!o.checkpoint.empty(), "--checkpoint (the chunk is the unit to rerun)"},
+                                                  {!o.aov.empty(), "--aov"}};
+  for (const auto& [given, flag] : clashes)
+    if (given) throw Error(std::string("--passes renders a chunk for fredholm merge and does not go with ") + flag);
   if (o.film.empty()) throw Error("--passes renders a chunk for fredholm merge: give --film FILE to save it to");
   s.firstPass = uint32_t(first);
   s.spp = int(end);
@@ -216,8 +219,9 @@ int mpiRank(const RenderOptions& o) {
 // Under mpirun: what a render shared by ranks cannot do (yet), refused on every rank alike;
 // and no progress bars (every rank's stderr reaches the terminal).
 void checkSharedRender(const RenderOptions& o, RenderSettings& settings) {
-  const char* clash = o.noise > 0 ? "--noise" : !o.aov.empty() ? "--aov" : nullptr;
-  if (clash) throw Error(std::string("under mpirun, ranks share a render without ") + clash + " (not yet supported)");
+  const std::pair<bool, const char*> clashes[] = {{o.noise > 0, "--noise"}, {!o.aov.empty(), "--aov"}};
+  for (const auto& [given, flag] : clashes)
+    if (given) throw Error(std::string("under mpirun, ranks share a render without ") + flag + " (not yet supported)");
   settings.progress = false;
 }
 
