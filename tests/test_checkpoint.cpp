@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "image/image_io.h"
+#include "render/checkpoint.h"
 #include "render/film.h"
 #include "test_support.h"
 
@@ -108,6 +109,21 @@ TEST(Checkpoint, CtrlCLeavesACheckpointToResumeFrom) {
   ASSERT_EQ(resumed.exitCode, 0) << resumed.output;
   ASSERT_EQ(test::runFredholm(render + " -o " + dir + "/straight.exr").exitCode, 0);
   EXPECT_TRUE(readImage(dir + "/resumed.exr").rgb == readImage(dir + "/straight.exr").rgb);
+}
+
+// The ranks' checkpoint files of a base, relative or absolute, named as each rank names its
+// own (so that the one rank 0 keeps on resuming is told from those it removes).
+TEST(Checkpoint, RankFilesAreFoundUnderTheNamesRanksGiveThem) {
+  const std::string dir = test::tempDir("rank-files");
+  for (const char* name : {"ck.rank0", "ck.rank12", "ck.rankA", "ck.rank", "ck", "other.rank1"})
+    test::writeFile(dir + "/" + name, "x");
+  EXPECT_EQ(rankCheckpointFiles(dir + "/ck"),
+            (std::vector<std::string>{rankCheckpointPath(dir + "/ck", 0), rankCheckpointPath(dir + "/ck", 12)}));
+  const auto cwd = std::filesystem::current_path();
+  std::filesystem::current_path(dir);
+  const std::vector<std::string> relative = rankCheckpointFiles("ck");
+  std::filesystem::current_path(cwd);
+  EXPECT_EQ(relative, (std::vector<std::string>{rankCheckpointPath("ck", 0), rankCheckpointPath("ck", 12)}));
 }
 
 // Every channel of an EXR (the image and its layers), as stored.

@@ -152,9 +152,10 @@ std::vector<std::string> rankCheckpointFiles(const std::string& base) {
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
     const std::string name = entry.path().filename().string();
+    // Named as rankCheckpointPath names them (base + suffix), so the two compare equal.
     if (name.size() > prefix.size() && name.compare(0, prefix.size(), prefix) == 0 &&
         name.find_first_not_of("0123456789", prefix.size()) == std::string::npos)
-      files.push_back((dir / name).string());
+      files.push_back(base + name.substr(path.filename().string().size()));
   }
   std::sort(files.begin(), files.end());
   return files;
