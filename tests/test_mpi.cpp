@@ -91,6 +91,17 @@ TEST(Mpi, AKilledRankIsRecoveredFromTheRanksCheckpoints) {
   EXPECT_EQ(all.describePasses(), "0:40");
 }
 
+// A render of one process, stopped, goes on shared by ranks from its checkpoint.
+TEST(Mpi, ARenderOfOneProcessGoesOnUnderMpirun) {
+  const std::string dir = test::tempDir("mpi-from-one");
+  const std::string args = "render --width 24 --height 16 --seed 8 --force ";
+  ASSERT_EQ(test::runFredholm(args + "--spp 30 -o " + dir + "/alone.exr").exitCode, 0);
+  ASSERT_EQ(test::runFredholm(args + "--spp 10 -o " + dir + "/part.exr --checkpoint " + dir + "/ck").exitCode, 0);
+  const auto r = mpirun(2, args + "--spp 30 --resume " + dir + "/ck --checkpoint " + dir + "/ck -o " + dir + "/out.exr");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_TRUE(readImage(dir + "/out.exr").rgb == readImage(dir + "/alone.exr").rgb);
+}
+
 TEST(Mpi, WhatRanksCannotShareIsAOneLineErrorThatEndsTheJob) {
   const std::string dir = test::tempDir("mpi-refused");
   const auto r = mpirun(2, kRender + "--noise 1e-2 -o " + dir + "/n.exr");

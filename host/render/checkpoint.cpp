@@ -162,8 +162,11 @@ std::vector<std::string> rankCheckpointFiles(const std::string& base) {
 }
 
 Film loadRankCheckpoints(const std::string& base, const std::string& fingerprint, const std::string& flag) {
-  const std::vector<std::string> files = rankCheckpointFiles(base);
-  if (files.empty()) throw Error(flag + " '" + base + "': no checkpoint of ranks there (" + base + ".rank0, ...)");
+  std::vector<std::string> files = rankCheckpointFiles(base);
+  // A render of one process goes on under mpirun from its own checkpoint.
+  if (files.empty() && std::filesystem::exists(base)) files.push_back(base);
+  if (files.empty())
+    throw Error(flag + " '" + base + "': no checkpoint there, of ranks (" + base + ".rank0, ...) or of one process");
   Film film;
   for (size_t i = 0; i < files.size(); ++i) {
     SavedFilm f = readFilm(files[i], flag);

@@ -43,8 +43,9 @@ Film loadCheckpoint(const std::string& path, const std::string& fingerprint, con
 std::string rankCheckpointPath(const std::string& base, int rank);
 // The files `base`.rank<r> there are, whatever the rank count that wrote them.
 std::vector<std::string> rankCheckpointFiles(const std::string& base);
-// Their films added into one (each may hold any passes); throws fh::Error naming `flag`
-// for none found, another render's file, or two that share passes.
+// Their films added into one (each may hold any passes), or, where there are none, the
+// checkpoint `base` of a render of one process; throws fh::Error naming `flag` for none
+// found, another render's file, or two that share passes.
 Film loadRankCheckpoints(const std::string& base, const std::string& fingerprint, const std::string& flag);
 
 }  // namespace fh
