@@ -217,12 +217,12 @@ int mpiRank(const RenderOptions& o) {
 }
 
 // Under mpirun: what a render shared by ranks cannot do (yet), refused on every rank alike;
-// and no progress bars (every rank's stderr reaches the terminal).
-void checkSharedRender(const RenderOptions& o, RenderSettings& settings) {
+// and one progress display, rank 0's (every rank's stderr reaches the terminal).
+void checkSharedRender(const RenderOptions& o, RenderSettings& settings, int rank) {
   const std::pair<bool, const char*> clashes[] = {{o.noise > 0, "--noise"}, {!o.aov.empty(), "--aov"}};
   for (const auto& [given, flag] : clashes)
     if (given) throw Error(std::string("under mpirun, ranks share a render without ") + flag + " (not yet supported)");
-  settings.progress = false;
+  settings.progress = rank == 0;
 }
 
 // Under mpirun, --resume FILE: rank 0 starts from every rank's checkpoint (FILE.rank<r>,
@@ -306,7 +306,7 @@ int runRender(RenderOptions o) {
   const bool debugView = !o.aov.empty();
   const Aov aov = debugView ? parseAov(o.aov) : Aov::Albedo;
   const int rank = mpiRank(o);
-  if (o.mpi) checkSharedRender(o, settings);
+  if (o.mpi) checkSharedRender(o, settings, rank);
   const std::vector<std::string> layers = checkOutputs(o, settings, rank);
   const auto devices = selectDevices(listDevices(), o.device);
   if (debugView && devices.size() > 1)

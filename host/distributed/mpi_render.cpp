@@ -4,7 +4,9 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
@@ -19,8 +21,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // Messages to rank 0: a request for a pass (answered with kTagPass: the pass, or -1 for
-// none left), or a rank's goodbye once its render is over.
-constexpr int kTagRequest = 1, kTagPass = 2, kTagBye = 3;
+// none left), a pass finished (for rank 0's progress display), or a rank's goodbye once its
+// render is over.
+constexpr int kTagRequest = 1, kTagPass = 2, kTagBye = 3, kTagFinished = 4;
 
 // FREDHOLM_SLOW_RANK=r: rank r is slowed on purpose (tests), as a rank on a slower machine.
 void slowDownIfAsked(int rank) {
@@ -50,12 +53,18 @@ class RootLedger : public PassLedger {
         ++byes;
         continue;
       }
+      if (status.MPI_TAG == kTagFinished) {
+        ++finishedElsewhere_;
+        continue;
+      }
       uint32_t pass = 0;
       int64_t reply = take(pass) ? int64_t(pass) : -1;
       MPI_Send(&reply, 1, MPI_INT64_T, status.MPI_SOURCE, kTagPass, MPI_COMM_WORLD);
       bytes += sizeof reply;
     }
   }
+
+  uint64_t finishedElsewhere() const override { return finishedElsewhere_; }
 
   uint64_t bytes = 0;  // sent: the answers
  private:
@@ -76,6 +85,7 @@ class RootLedger : public PassLedger {
   const uint32_t total_;
   const double seconds_;
   const Film* done_;
+  std::atomic<uint64_t> finishedElsewhere_{0};
   uint32_t next_ = 0;
   bool started_ = false;
   Clock::time_point start_;
@@ -95,6 +105,12 @@ class RemoteLedger : public PassLedger {
     if (reply < 0) return false;
     pass = uint32_t(reply);
     return true;
+  }
+
+  void finished(uint32_t pass) override {
+    int64_t message = int64_t(pass);
+    MPI_Send(&message, 1, MPI_INT64_T, 0, kTagFinished, MPI_COMM_WORLD);
+    bytes += sizeof message;
   }
 
   void bye() {
@@ -176,12 +192,17 @@ bool startedByMpirun() {
 }
 
 MpiSession::MpiSession(int* argc, char*** argv) {
-  // Worker threads ask for passes (one at a time, under the pool's lock), and rank 0's
-  // server thread answers while its main thread renders: calls come from several threads.
+  // Worker threads ask for passes (one at a time, under the pool's lock) while the pool's
+  // merger thread reports finished passes, and rank 0's server thread answers while its
+  // main thread renders: calls come from several threads at once.
   int provided = 0;
   MPI_Init_thread(argc, argv, MPI_THREAD_MULTIPLE, &provided);
   MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
   MPI_Comm_size(MPI_COMM_WORLD, &size_);
+  if (provided < MPI_THREAD_MULTIPLE) {
+    if (rank_ == 0) std::fprintf(stderr, "fredholm: error: this MPI library does not support MPI_THREAD_MULTIPLE\n");
+    abort(1);
+  }
 }
 
 MpiSession::~MpiSession() { MPI_Finalize(); }

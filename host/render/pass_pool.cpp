@@ -123,7 +123,8 @@ Film PassPool::finish(bool& complete) {
     ++merged_;
   }
   pending_.clear();
-  progress_.finish(merged_ * film_.pixels(), secondsSince(start_));
+  if (settings_.ledger) progress_.end();  // other processes may still be rendering
+  else progress_.finish(merged_ * film_.pixels(), secondsSince(start_));
   return film_;
 }
 
@@ -152,6 +153,7 @@ void PassPool::mergeInOrder() {
     film_.addPass(pass, samples);
     const bool check = settings_.noise > 0.0 && film_.passes() >= kNoiseMinPasses;
     const double estimate = check ? film_.estimatedRelMse() : -1.0;
+    if (settings_.ledger) settings_.ledger->finished(pass);
     lock.lock();
     spare_.push_back(std::move(samples));
     ++nextToMerge_;
@@ -192,7 +194,8 @@ void PassPool::showProgress() {
   // relMSE falls as 1 / samples, so target / estimate is the share of samples taken.
   const double noiseShare = noiseEstimate_ > 0.0 ? std::min(1.0, settings_.noise / noiseEstimate_) : 0.0;
   const uint64_t passes = total_ - film_.firstPass();
-  progress_.update(merged_ * film_.pixels(), timed || noisy ? 0 : passes * film_.pixels(), elapsed,
+  const uint64_t elsewhere = settings_.ledger ? settings_.ledger->finishedElsewhere() : 0;
+  progress_.update((merged_ + elsewhere) * film_.pixels(), timed || noisy ? 0 : passes * film_.pixels(), elapsed,
                    noisy ? std::min(1.0, std::max(noiseShare, timed ? elapsed / settings_.seconds : 0.0))
                          : timed ? std::min(1.0, elapsed / settings_.seconds) : 0.0);
 }

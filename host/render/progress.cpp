@@ -30,6 +30,10 @@ void Progress::update(uint64_t samples, uint64_t total, double seconds, double f
                static_cast<unsigned long long>(samples), seconds, remaining, rate);
 }
 
+void Progress::end() {
+  if (enabled_ && terminal_) std::fputc('\n', stderr);
+}
+
 void Progress::finish(uint64_t samples, double seconds) {
   if (!enabled_) return;
   if (terminal_) std::fputc('\n', stderr);

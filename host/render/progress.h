@@ -10,6 +10,9 @@ class Progress {
   explicit Progress(bool enabled);
   // total == 0: unknown (a time budget), then `fraction` of the budget is shown.
   void update(uint64_t samples, uint64_t total, double seconds, double fraction);
+  // Ends the display without a total (a process whose share of a render is done while
+  // others still render: the command's summary gives the whole render's).
+  void end();
   void finish(uint64_t samples, double seconds);
 
  private:
