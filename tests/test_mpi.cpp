@@ -102,6 +102,20 @@ TEST(Mpi, ARenderOfOneProcessGoesOnUnderMpirun) {
   EXPECT_TRUE(readImage(dir + "/out.exr").rgb == readImage(dir + "/alone.exr").rgb);
 }
 
+// Ctrl-C on mpirun (which passes SIGTERM to the ranks): every rank stops, hands its film
+// over, and rank 0 writes the image of the passes finished so far, marked incomplete.
+TEST(Mpi, CtrlCWritesThePassesFinishedSoFar) {
+  const std::string dir = test::tempDir("mpi-ctrl-c");
+  const std::string out = dir + "/out.exr";
+  const auto r = test::runCommand("(" + kMpiEnvironment + " mpirun --oversubscribe --bind-to none -np 2 " +
+                                  FREDHOLM_BINARY + " render --width 32 --height 32 --spp 1000000 -o " + out +
+                                  " & job=$!; sleep 8; kill -INT $job; wait $job)");
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_NE(r.output.find("fredholm: interrupted: wrote the "), std::string::npos) << r.output;
+  ASSERT_TRUE(std::filesystem::exists(out)) << r.output;
+  EXPECT_EQ(readImage(out).width, 32);
+}
+
 TEST(Mpi, WhatRanksCannotShareIsAOneLineErrorThatEndsTheJob) {
   const std::string dir = test::tempDir("mpi-refused");
   const auto r = mpirun(2, kRender + "--noise 1e-2 -o " + dir + "/n.exr");

@@ -212,8 +212,9 @@ int main(int argc, char** argv) {
     if (*exporter) return runExport(exporting);
     if (*merging) return runMerge(merge);
   } catch (const Interrupted& e) {
+    // Every rank has stopped and handed its film over by now: the job ends as it is.
     std::cerr << "fredholm: interrupted: " << e.what() << "\n";
-    return failed(e.exitCode());
+    return e.exitCode();
   } catch (const BuildError& e) {
     std::cerr << "fredholm: error: " << e.what() << "\n";
     return failed(1);
