@@ -110,8 +110,7 @@ SavedFilm readFilm(const std::string& path, const std::string& flag) {
     throw Error(notAFilm);
   // The sums' sizes follow from the header: checked against the file before allocating.
   const uint64_t pixels = uint64_t(width) * uint64_t(height);
-  if ((aovs != 0 && aovs != pixels * kAovSumsPerPixel) || (odd != 0 && odd != pixels * 3))
-    throw Error(flag + " '" + path + "': not a fredholm film or checkpoint");
+  if ((aovs != 0 && aovs != pixels * kAovSumsPerPixel) || (odd != 0 && odd != pixels * 3)) throw Error(notAFilm);
   const auto body = in.tellg();
   in.seekg(0, std::ios::end);
   const uint64_t bytes = uint64_t(in.tellg() - body);
@@ -121,8 +120,7 @@ SavedFilm readFilm(const std::string& path, const std::string& flag) {
   for (std::vector<double>* v : sums(f.film))
     if (!in.read(reinterpret_cast<char*>(v->data()), std::streamsize(v->size() * 8)))
       throw Error(flag + " '" + path + "': the file is cut short");
-  if (in.peek() != std::char_traits<char>::eof())
-    throw Error(flag + " '" + path + "': not a fredholm film or checkpoint");
+  if (in.peek() != std::char_traits<char>::eof()) throw Error(notAFilm);
   // Every pass adds one sample to every pixel.
   for (size_t p = 0; p < f.film.pixels(); ++p)
     if (f.film.count(p) != double(passes)) throw Error(flag + " '" + path + "': the film's sample counts do not add up");
@@ -161,30 +159,39 @@ std::vector<std::string> rankCheckpointFiles(const std::string& base) {
   return files;
 }
 
+SavedFilm mergeFilms(const std::vector<std::string>& paths, const std::string& fingerprint, const std::string& flag) {
+  std::vector<std::pair<std::string, SavedFilm>> films;
+  for (const std::string& path : paths) films.emplace_back(path, readFilm(path, flag));
+  const std::string expected = fingerprint.empty() ? films.front().second.fingerprint : fingerprint;
+  for (const auto& [path, saved] : films)
+    if (saved.fingerprint != expected)
+      throw Error(flag + " '" + path + "': is a chunk of another render than " +
+                  (fingerprint.empty() ? "'" + films.front().first + "'" : std::string("this one")) +
+                  " (another scene, camera or settings: size, seed, method, depths, environment, filter, --noise, "
+                  "--aovs)");
+  // In the order of their first passes: the sums of squares, not exact, then add up alike.
+  std::stable_sort(films.begin(), films.end(), [](const auto& a, const auto& b) {
+    return a.second.film.firstPass() < b.second.film.firstPass();
+  });
+  SavedFilm merged{films.front().second.film, expected};
+  for (size_t i = 1; i < films.size(); ++i) {
+    try {
+      merged.film.merge(films[i].second.film);
+    } catch (const Error& e) {
+      throw Error(flag + " '" + films[i].first + "' (passes " + films[i].second.film.describePasses() +
+                  ", joining " + merged.film.describePasses() + "): " + e.what());
+    }
+  }
+  return merged;
+}
+
 Film loadRankCheckpoints(const std::string& base, const std::string& fingerprint, const std::string& flag) {
   std::vector<std::string> files = rankCheckpointFiles(base);
   // A render of one process goes on under mpirun from its own checkpoint.
   if (files.empty() && std::filesystem::exists(base)) files.push_back(base);
   if (files.empty())
     throw Error(flag + " '" + base + "': no checkpoint there, of ranks (" + base + ".rank0, ...) or of one process");
-  Film film;
-  for (size_t i = 0; i < files.size(); ++i) {
-    SavedFilm f = readFilm(files[i], flag);
-    if (f.fingerprint != fingerprint)
-      throw Error(flag + " '" + files[i] + "': saved by a render of another scene, camera or settings; resume with "
-                  "the same ones");
-    if (i == 0) {
-      film = std::move(f.film);
-      continue;
-    }
-    try {
-      film.merge(f.film);
-    } catch (const Error&) {
-      throw Error(flag + " '" + files[i] + "': shares passes with the other ranks' checkpoints (" +
-                  film.describePasses() + "); remove the stale one");
-    }
-  }
-  return film;
+  return mergeFilms(files, fingerprint, flag).film;
 }
 
 }  // namespace fh

@@ -39,13 +39,17 @@ SavedFilm readFilm(const std::string& path, const std::string& flag);
 // that does not start at pass 0.
 Film loadCheckpoint(const std::string& path, const std::string& fingerprint, const std::string& flag);
 
+// The films saved at `paths` added into one (each may hold any passes), with the fingerprint
+// they share: each saved by the render with `fingerprint` (empty: the first file's), no two
+// holding a pass in common. Throws fh::Error naming `flag` and the file at fault.
+SavedFilm mergeFilms(const std::vector<std::string>& paths, const std::string& fingerprint, const std::string& flag);
+
 // Ranks sharing a render (host/distributed) checkpoint to a file each: `base`.rank<r>.
 std::string rankCheckpointPath(const std::string& base, int rank);
 // The files `base`.rank<r> there are, whatever the rank count that wrote them.
 std::vector<std::string> rankCheckpointFiles(const std::string& base);
-// Their films added into one (each may hold any passes), or, where there are none, the
-// checkpoint `base` of a render of one process; throws fh::Error naming `flag` for none
-// found, another render's file, or two that share passes.
+// Their films merged (mergeFilms), or, where there are none, the checkpoint `base` of a
+// render of one process; throws fh::Error naming `flag` where mergeFilms does or for none.
 Film loadRankCheckpoints(const std::string& base, const std::string& fingerprint, const std::string& flag);
 
 }  // namespace fh

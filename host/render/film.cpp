@@ -26,13 +26,17 @@ Film::Film(int w, int h, bool surfaceAovs, bool twoReplicates, uint64_t firstPas
       firstPass_(firstPass) {}
 
 void Film::merge(const Film& other) {
+  if (other.width != width || other.height != height || other.aovSum.size() != aovSum.size() ||
+      other.oddSum.size() != oddSum.size())
+    throw Error("is not a film of the same size and layers");
   PassRanges ranges = held_;
   ranges.insert(ranges.end(), other.held_.begin(), other.held_.end());
   std::sort(ranges.begin(), ranges.end());
   for (size_t i = 1; i < ranges.size(); ++i)
     if (ranges[i].first < ranges[i - 1].second)
-      throw Error("films that share passes (" + std::to_string(ranges[i].first) + ":" +
-                  std::to_string(std::min(ranges[i].second, ranges[i - 1].second)) + ") cannot be merged");
+      throw Error("shares passes (" + std::to_string(ranges[i].first) + ":" +
+                  std::to_string(std::min(ranges[i].second, ranges[i - 1].second)) +
+                  ") with the film it joins; each pass may be merged once");
   addEach(sum, other.sum);
   addEach(sumSq, other.sumSq);
   addEach(aovSum, other.aovSum);
@@ -75,9 +79,8 @@ void Film::addPass(uint64_t pass, const std::vector<float>& samples) {
   if (!oddSum.empty() && pass % 2 == 1)
     for (size_t p = 0; p < pixels(); ++p)
       for (size_t c = 0; c < 3; ++c) oddSum[3 * p + c] += quantized(samples[4 * p + c]);
-  PassRanges ranges = held_;
-  ranges.emplace_back(pass, pass + 1);
-  setPassRanges(std::move(ranges));
+  held_.emplace_back(pass, pass + 1);
+  setPassRanges(held_);
   if (!hasSurfaceAovs()) return;
   const float* aovs = samples.data() + sum.size();
   for (size_t p = 0; p < pixels(); ++p) {

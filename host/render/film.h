@@ -42,8 +42,9 @@ struct Film {
   void addPass(uint64_t pass, const std::vector<float>& samples);
   // Adds the pass after the last one held (firstPass for an empty film).
   void addPass(const std::vector<float>& samples) { addPass(nextPass(), samples); }
-  // Adds another film's passes: a chunk of the same render (same size and layers). Exact
-  // but for sumSq. Throws fh::Error if the two hold a pass in common.
+  // Adds another film's passes: a chunk of the same render. Exact but for sumSq. Throws
+  // fh::Error (a message to follow the other film's name) if the two differ in size or
+  // layers, or hold a pass in common.
   void merge(const Film& other);
 
   // The passes the film holds, as ascending, disjoint, non-adjacent [begin, end) ranges.
