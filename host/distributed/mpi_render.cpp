@@ -98,35 +98,31 @@ class RemoteLedger : public PassLedger {
 
   bool next(uint32_t& pass) override {
     slowDownIfAsked(rank_);
-    int64_t message = 0, reply = -1;
-    MPI_Send(&message, 1, MPI_INT64_T, 0, kTagRequest, MPI_COMM_WORLD);
+    tellRoot(kTagRequest, 0);
+    int64_t reply = -1;
     MPI_Recv(&reply, 1, MPI_INT64_T, 0, kTagPass, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-    bytes += sizeof message;
     if (reply < 0) return false;
     pass = uint32_t(reply);
     return true;
   }
 
-  void finished(uint32_t pass) override {
-    int64_t message = int64_t(pass);
-    MPI_Send(&message, 1, MPI_INT64_T, 0, kTagFinished, MPI_COMM_WORLD);
-    bytes += sizeof message;
-  }
+  void finished(uint32_t pass) override { tellRoot(kTagFinished, pass); }
+  void bye() { tellRoot(kTagBye, 0); }
 
-  void bye() {
-    int64_t message = 0;
-    MPI_Send(&message, 1, MPI_INT64_T, 0, kTagBye, MPI_COMM_WORLD);
-    bytes += sizeof message;
-  }
-
-  uint64_t bytes = 0;  // sent: the requests
+  uint64_t bytes = 0;  // sent: requests, reports, goodbye
 
  private:
+  void tellRoot(int tag, int64_t value) {
+    MPI_Send(&value, 1, MPI_INT64_T, 0, tag, MPI_COMM_WORLD);
+    bytes += sizeof value;
+  }
+
   int rank_;
 };
 
 // Sums every rank's film onto rank 0's (in place there). Returns the bytes this rank sent.
-uint64_t reduceFilm(Film& film, int rank) {
+uint64_t reduceFilm(Film& film, const MpiSession& mpi) {
+  const int rank = mpi.rank();
   uint64_t bytes = 0;
   for (std::vector<double>* v : {&film.sum, &film.sumSq, &film.aovSum, &film.oddSum}) {
     if (v->empty()) continue;
@@ -137,9 +133,8 @@ uint64_t reduceFilm(Film& film, int rank) {
   // Which passes the sums hold: every rank's ranges, gathered.
   std::vector<uint64_t> mine;
   for (const auto& [begin, end] : film.passRanges()) mine.insert(mine.end(), {begin, end});
-  int count = int(mine.size()), ranks = 0;
-  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
-  std::vector<int> counts(static_cast<size_t>(ranks)), offsets(static_cast<size_t>(ranks));
+  int count = int(mine.size());
+  std::vector<int> counts(static_cast<size_t>(mpi.size())), offsets(static_cast<size_t>(mpi.size()));
   MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
   for (size_t k = 1; k < counts.size(); ++k) offsets[k] = offsets[k - 1] + counts[k - 1];
   std::vector<uint64_t> all(size_t(offsets.back() + counts.back()));
@@ -234,7 +229,7 @@ RenderResult renderAcrossRanks(const MpiSession& mpi, const std::vector<DeviceIn
   else remote.bye();
 
   const uint64_t passes = r.film.passes();
-  const uint64_t bytes = reduceFilm(r.film, mpi.rank()) + (mpi.rank() == 0 ? root.bytes : remote.bytes);
+  const uint64_t bytes = reduceFilm(r.film, mpi) + (mpi.rank() == 0 ? root.bytes : remote.bytes);
   gatherShares(mpi, r, passes, seconds, bytes);
   int complete = r.complete ? 1 : 0, allComplete = 0;
   MPI_Reduce(&complete, &allComplete, 1, MPI_INT, MPI_MIN, 0, MPI_COMM_WORLD);

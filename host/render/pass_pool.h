@@ -37,8 +37,8 @@ class PassPool : public PassSource {
   uint64_t passesDone(int worker) const;
   // Ends the render: saves the checkpoint (the passes merged in order), merges whatever
   // finished out of order (passes lost with every device leave gaps: the film records which
-  // passes it holds), closes the progress
-  // display, and returns the film. `complete` is false when some pass was never rendered.
+  // passes it holds), closes the progress display, and returns the film. `complete` is
+  // false when some pass was never rendered.
   Film finish(bool& complete);
   // Checkpoints that could not be written (the render goes on without them).
   std::vector<std::string> warnings() const;

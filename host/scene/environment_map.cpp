@@ -54,12 +54,14 @@ EnvironmentMap makeEnvironmentMap(const std::string& source, int width, int heig
   map.rotateDeg = rotateDeg;
   map.scale = scale;
   map.texels.resize(size_t(width) * size_t(height) * 4);
-  // Texel weights: luminance times sin(theta) at the row's centre, the texel's solid angle
-  // up to a constant.
+  // Texel i's weight in row y: its luminance times sin(theta) at the row's centre, the
+  // texel's solid angle up to a constant.
+  auto weightOf = [&](size_t i, int y) {
+    return std::max(0.0, luminance(&map.texels[4 * i])) * std::sin(kPi * (y + 0.5) / height);
+  };
   std::vector<double> rowWeights(static_cast<size_t>(height)), weights(static_cast<size_t>(width));
   double total = 0.0;
   for (int y = 0; y < height; ++y) {
-    const double sinTheta = std::sin(kPi * (y + 0.5) / height);
     double rowTotal = 0.0;
     for (int x = 0; x < width; ++x) {
       const size_t i = size_t(y) * size_t(width) + size_t(x);
@@ -70,7 +72,7 @@ EnvironmentMap makeEnvironmentMap(const std::string& source, int width, int heig
                       ") holds a negative or non-finite radiance");
         map.texels[4 * i + c] = v * scale;
       }
-      weights[size_t(x)] = std::max(0.0, luminance(&map.texels[4 * i])) * sinTheta;
+      weights[size_t(x)] = weightOf(i, y);
       rowTotal += weights[size_t(x)];
     }
     appendCdf(weights, map.rowCdf);
@@ -80,14 +82,11 @@ EnvironmentMap makeEnvironmentMap(const std::string& source, int width, int heig
   appendCdf(rowWeights, map.marginalCdf);
   // A texel's density per unit (u, v) area: its share of the total times the texel count.
   // Black texels (and a black map) get none: light sampling never picks them.
-  for (int y = 0; y < height; ++y) {
-    const double sinTheta = std::sin(kPi * (y + 0.5) / height);
+  for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
       const size_t i = size_t(y) * size_t(width) + size_t(x);
-      const double w = std::max(0.0, luminance(&map.texels[4 * i])) * sinTheta;
-      map.texels[4 * i + 3] = total > 0.0 ? float(w / total * double(width) * double(height)) : 0.f;
+      map.texels[4 * i + 3] = total > 0.0 ? float(weightOf(i, y) / total * double(width) * double(height)) : 0.f;
     }
-  }
   // The solid angle of a texel is (2 pi / width)(pi / height) sin(theta).
   map.luminanceIntegral = total * 2.0 * kPi * kPi / (double(width) * double(height));
   return map;
