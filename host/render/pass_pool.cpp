@@ -193,7 +193,7 @@ void PassPool::showProgress() {
   const bool timed = settings_.seconds > 0.0, noisy = settings_.noise > 0.0;
   // relMSE falls as 1 / samples, so target / estimate is the share of samples taken.
   const double noiseShare = noiseEstimate_ > 0.0 ? std::min(1.0, settings_.noise / noiseEstimate_) : 0.0;
-  const uint64_t passes = total_ - film_.firstPass();
+  const uint64_t passes = total_ - settings_.firstPass;  // this render's, or this chunk's
   const uint64_t elsewhere = settings_.ledger ? settings_.ledger->finishedElsewhere() : 0;
   progress_.update((merged_ + elsewhere) * film_.pixels(), timed || noisy ? 0 : passes * film_.pixels(), elapsed,
                    noisy ? std::min(1.0, std::max(noiseShare, timed ? elapsed / settings_.seconds : 0.0))
