@@ -6,15 +6,28 @@
 #include "path_state.h"
 #include "sampler.h"
 
+// The shape of the passes in flight (WavefrontCounters::pass_pixels and after), read once.
+typedef struct {
+  uint pixels, first_sample, first_pass;
+} PassShape;
+#define FH_PASS_SHAPE(counters) \
+  ((PassShape){(counters)->pass_pixels, (counters)->round_first_sample, (counters)->round_first_pass})
+
 // Starts device sample j (a device numbers its samples locally) in path slot `slot`. Its
 // passes are granted by the host, which may hand different passes to different devices:
-// local pass j / pixel_count is global pass pass_table[j / pixel_count]. Global sample
+// from the shape's first sample on, every shape.pixels samples are one local pass, whose
+// global pass is in pass_table (a ring of FH_PASS_SLOTS entries: a pass's entry is reused
+// once it is returned), and sample i of a pass renders pixel_list[i]. Global sample
 // k = pass * pixel_count + pixel seeds the random numbers, so a sample is the same
-// whichever device renders it.
-FH_INLINE void start_sample(RenderParams params, luint j, luint slot, lmask active, __global const float* filter_table,
-                            __global const uint* pass_table FH_PATH_PARAMS) {
-  const luint pixel = j % params.pixel_count, device_pass = j / params.pixel_count;
-  const luint pass = gather_uint(pass_table, device_pass);
+// whichever device renders it, and the pixel's samples are its passes' points of one
+// sequence whichever passes cover it.
+FH_INLINE void start_sample(RenderParams params, PassShape shape, luint j, luint slot, lmask active,
+                            __global const float* filter_table, __global const uint* pass_table,
+                            __global const uint* pixel_list FH_PATH_PARAMS) {
+  const luint in_round = j - shape.first_sample;
+  const luint device_pass = shape.first_pass + in_round / shape.pixels;
+  const luint pixel = gather_uint(pixel_list, in_round % shape.pixels);
+  const luint pass = gather_uint(pass_table, device_pass % FH_PASS_SLOTS);
   const luint k = pass * params.pixel_count + pixel;
   const PixelSampler sampler = pixel_sampler(params.seed, k, params.pixel_count, params.replicates);
   const lvec2 u = sample_2d(&sampler, (luint)(FH_DIM_PIXEL));
@@ -36,13 +49,14 @@ FH_INLINE void start_sample(RenderParams params, luint j, luint slot, lmask acti
 // the ray queue.
 __kernel void generate(RenderParams params, __global const WavefrontCounters* counters,
                        __global const uint* free_list, __global uint* ray_queue, __global const float* filter_table,
-                       __global const uint* pass_table FH_PATH_PARAMS) {
+                       __global const uint* pass_table, __global const uint* pixel_list FH_PATH_PARAMS) {
   const luint position = lane_positions(get_global_id(0) * FH_LANES);
   const lmask active = position < counters->new_count;
   if (!lanes_any(active)) return;
   const luint i = select((luint)(0), position, active);  // idle lanes compute sample 0 and write nothing
   const luint slot = gather_uint(free_list, counters->new_free_top - 1 - i);
-  start_sample(params, counters->new_first + i, slot, active, filter_table, pass_table FH_PATH_ARGS);
+  start_sample(params, FH_PASS_SHAPE(counters), counters->new_first + i, slot, active, filter_table, pass_table,
+               pixel_list FH_PATH_ARGS);
   scatter_uint(ray_queue, counters->new_queue_base + i, slot, active);
 }
 #endif

@@ -13,7 +13,8 @@
 
 __kernel void megakernel(RenderParams params, volatile __global WavefrontCounters* counters, uint parity,
                          __global const uint* free_list, __global const float* filter_table,
-                         __global const uint* pass_table, __global const Bvh8Node* nodes,
+                         __global const uint* pass_table, __global const uint* pixel_list,
+                         __global const Bvh8Node* nodes,
                          __global const TriangleBlock8* blocks, __global const float4* triangles,
                          __global const int* triangle_material, __global const GpuMaterial* materials,
                          __global const float* light_cdf, __global const int* light_triangle,
@@ -33,6 +34,7 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
   // Lane g owns free slot g (all are free between launches) and takes samples g, g + slots,
   // g + 2 slots, ... of the new_count planned.
   const uint slots = counters->new_free_top, count = counters->new_count;
+  const PassShape shape = FH_PASS_SHAPE(counters);
   const luint g = lane_positions(get_global_id(0) * FH_LANES);
   const lmask owns_slot = g < slots && g < count;
   if (lanes_any(owns_slot)) {
@@ -43,7 +45,8 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
     for (;;) {
       const lmask starts = owns_slot && !alive && next < count;
       if (lanes_any(starts)) {
-        start_sample(params, counters->new_first + next, p, starts, filter_table, pass_table FH_PATH_ARGS);
+        start_sample(params, shape, counters->new_first + next, p, starts, filter_table, pass_table, pixel_list
+                     FH_PATH_ARGS);
         next = select(next, next + slots, starts);
         alive = alive || starts;
       }

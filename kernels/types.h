@@ -106,6 +106,13 @@ typedef struct {
   uint shadow_rays[2];   // light-sample requests (shadow rays at most)
   uint queued_rays[2];   // rays in the current queue, summed over iterations (occupancy)
   uint iterations;
+  // The passes in flight share one shape: each covers pass_pixels pixels, those listed
+  // first in the pixel list (every pixel, or an adaptive round's, render/adaptive.h); the
+  // shape's first pass starts at local sample round_first_sample and is local pass
+  // round_first_pass. The host sets them when no pass is in flight.
+  uint pass_pixels;
+  uint round_first_sample;
+  uint round_first_pass;
   uint pass_done[FH_MAX_PASS_SLOTS];  // per pass slot: paths finished in the pass it holds
 } WavefrontCounters;
 

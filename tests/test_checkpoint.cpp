@@ -84,9 +84,10 @@ TEST(Checkpoint, OtherSettingsOrADamagedFileAreRefused) {
   std::string header;
   std::getline(std::ifstream(ckpt), header);
   const std::string fingerprint = header.substr(header.find(' ') + 1, 16);
-  test::writeFile(dir + "/huge.fhc", "fredholm-film-2 " + fingerprint + " 16384 16384 0 3 0 0\n0123");
+  test::writeFile(dir + "/huge.fhc", "fredholm-film-3 " + fingerprint + " 16384 16384 1 0 3 0 0 0\n0123");
   const auto huge = test::runFredholm(kRender + " --resume " + dir + "/huge.fhc -o " + dir + "/e.exr");
   EXPECT_EQ(huge.exitCode, 1);
+  EXPECT_NE(huge.output.find("cut short"), std::string::npos) << huge.output;
   test::writeFile(dir + "/junk.fhc", "not a checkpoint\n");
   const auto junk = test::runFredholm(kRender + " --resume " + dir + "/junk.fhc -o " + dir + "/d.exr");
   EXPECT_EQ(junk.exitCode, 1);

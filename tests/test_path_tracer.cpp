@@ -43,7 +43,7 @@ struct Rendered {
 };
 
 Rendered render(const Scene& scene, const Camera& camera, Method method, int size, int spp, unsigned seed = 1,
-                size_t wavefront = 0, std::array<float, 3> env = {0, 0, 0}, int maxDepth = 64) {
+                size_t wavefront = 0, std::array<float, 3> env = {0, 0, 0}, int maxDepth = 64, bool adaptive = false) {
   DeviceContext& dc = test::defaultDevice();
   const Bvh bvh = buildBvh(scene);
   RenderSettings s = test::renderSettings();
@@ -54,8 +54,15 @@ Rendered render(const Scene& scene, const Camera& camera, Method method, int siz
   s.wavefront = wavefront;
   s.env = env;
   s.maxDepth = maxDepth;
+  s.adaptive = adaptive;
   RenderResult r = fh::render(dc, scene, bvh, camera, s);
   return {r.film, r.stats};
+}
+
+// An adaptive render (render/adaptive.h): spp is its budget, the image's average.
+Rendered renderAdaptive(const Scene& scene, const Camera& camera, Method method, int size, int spp,
+                        size_t wavefront = 0) {
+  return render(scene, camera, method, size, spp, 1, wavefront, {0, 0, 0}, 64, true);
 }
 
 double luminanceMean(const Film& f, size_t p) {
@@ -149,6 +156,63 @@ TEST_P(EveryMethod, PlaneUnderRectangularEmitterFollowsLambertsFormula) {
   // more than one surface are skipped.
   const Image exact = PlaneUnderLight::reference(scene.camera, size, size, 8, true);
   expectMatches(r.film, [&](size_t p) { return double(exact.rgb[3 * p]); }, methodName(GetParam()));
+}
+
+// Adaptive sampling keeps each pixel its own mean: the same closed form holds where pixels
+// have different sample counts. The camera looks up, over the plane's far edge: most pixels
+// see nothing (no noise) and get fewer samples than the plane's few rows (the emitter's
+// edges are noisy too, for the filter). The budget is not exceeded.
+TEST_P(EveryMethod, AdaptiveSamplingFollowsLambertsFormulaWithSamplesWhereTheNoiseIs) {
+  const Scene scene = PlaneUnderLight::scene();
+  Camera camera = scene.camera;
+  camera.target = {0.f, 2.6f, -5.f};
+  const int size = 32, spp = 256;
+  const Rendered r = renderAdaptive(scene, camera, GetParam(), size, spp);
+  EXPECT_EQ(r.stats.nonfinite, 0u);
+  // 16 x 16 points per pixel: at the plane's far edge, seen at a grazing angle, fewer can
+  // miss the few pixels the edge only clips.
+  const Image exact = PlaneUnderLight::reference(camera, size, size, 16, true);
+  expectMatches(r.film, [&](size_t p) { return double(exact.rgb[3 * p]); },
+                std::string("adaptive ") + methodName(GetParam()));
+  // Quiet: pixels that see nothing, three pixels or more from anything they could be
+  // sampled with (a round takes a noisy pixel's 5x5 block and its neighbours).
+  const auto seesNothingAround = [&](int x, int y) {
+    for (int dy = -3; dy <= 3; ++dy)
+      for (int dx = -3; dx <= 3; ++dx) {
+        const int nx = std::clamp(x + dx, 0, size - 1), ny = std::clamp(y + dy, 0, size - 1);
+        if (exact.rgb[3 * size_t(ny * size + nx)] != 0.f) return false;  // NaN too
+      }
+    return true;
+  };
+  double quiet = 0, plane = 0, total = 0;
+  size_t quietPixels = 0, planePixels = 0;
+  for (size_t p = 0; p < r.film.pixels(); ++p) {
+    total += r.film.count(p);
+    const float e = exact.rgb[3 * p];
+    if (e > 0.f && e < PlaneUnderLight::kLe) {
+      plane += r.film.count(p);
+      ++planePixels;
+    } else if (seesNothingAround(int(p % size_t(size)), int(p / size_t(size)))) {
+      quiet += r.film.count(p);
+      ++quietPixels;
+    }
+  }
+  ASSERT_GT(quietPixels, 0u);
+  ASSERT_GT(planePixels, 0u);
+  EXPECT_LE(total, double(spp) * double(r.film.pixels()));
+  EXPECT_EQ(double(r.stats.samples), total);
+  EXPECT_LT(quiet / double(quietPixels), 0.5 * plane / double(planePixels)) << methodName(GetParam());
+}
+
+// An adaptive render's rounds are chosen from films merged in pass order: the image for a
+// seed does not depend on how many passes were in flight (the wavefront's size).
+TEST(AdaptiveSampling, TheImageDoesNotDependOnTheWavefront) {
+  const Scene scene = loadDefaultScene();
+  const Rendered a = renderAdaptive(scene, scene.camera, Method::MIS, 24, 96);
+  const Rendered b = renderAdaptive(scene, scene.camera, Method::MIS, 24, 96, 64);
+  EXPECT_EQ(a.film.sum, b.film.sum);
+  EXPECT_EQ(a.film.passes(), b.film.passes());
+  EXPECT_GT(a.film.passes(), 96u) << "later passes cover fewer pixels";
 }
 
 TEST_P(EveryMethod, PlaneUnderConstantEnvironmentIsRhoTimesEnv) {

@@ -196,6 +196,9 @@ TEST_P(UnderOclgrind, RunsWithoutReports) {
     args = "bench " + scenes.features + " --width 8 --height 8 --repeats 1";
   else if (run == "aov")
     args = "render " + scenes.copies + " --aov normal --width 8 --height 8 -o " + scenes.dir + "/aov.exr";
+  else if (run == "adaptive")  // later rounds' passes cover some pixels (render/adaptive.h)
+    args = "render " + test::projectScene("failure/caustic.obj") +
+           " --adaptive --width 8 --height 8 --spp 24 --wavefront 64 -o " + scenes.dir + "/adaptive.exr";
   else if (run == "env")  // mis with an environment map beside the scene's light
     args = "render " + scenes.features + " --env-map " + writeEnvironmentMap(scenes.dir) +
            " --width 8 --height 8 --spp 1 --wavefront 64 -o " + scenes.dir + "/env.exr";
@@ -213,7 +216,7 @@ TEST_P(UnderOclgrind, RunsWithoutReports) {
   EXPECT_TRUE(reports.empty()) << run << ": Oclgrind reported:\n" << reports.substr(0, 4000);
 }
 
-INSTANTIATE_TEST_SUITE_P(Runs, UnderOclgrind, ::testing::Values("pt", "nee", "mis", "aov", "bench", "env"),
+INSTANTIATE_TEST_SUITE_P(Runs, UnderOclgrind, ::testing::Values("pt", "nee", "mis", "aov", "bench", "env", "adaptive"),
                          [](const ::testing::TestParamInfo<const char*>& p) { return std::string(p.param); });
 
 }  // namespace

@@ -20,6 +20,7 @@ struct RenderOptions {
   std::optional<int> spp;  // unset: 64 (4 for --aov), or as many as --time allows
   double seconds = 0.0;
   double noise = 0.0;  // --noise: the estimated relMSE to stop at; 0: none
+  bool adaptive = false;  // --adaptive: later passes cover the noisy pixels
   std::string method = "mis", filter = "box", env, statsFile, strategy = "auto";
   std::string envMap;  // --env-map FILE (.exr, .hdr)
   std::optional<float> envRotate, envScale;

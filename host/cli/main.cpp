@@ -45,6 +45,9 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
   rendering->add_option("--noise", o.noise,
                         "Stop once the image's relMSE, estimated from two independently scrambled halves of the "
                         "samples (even and odd passes), is at most this (e.g. 1e-3); --spp and --time still cap it");
+  rendering->add_flag("--adaptive", o.adaptive,
+                      "Adaptive sampling: after 16 passes over every pixel, spend samples where the estimated "
+                      "error falls fastest (--spp is then the image's average, a budget)");
   rendering->add_option("--max-depth", o.maxDepth, "Most bounces (Russian roulette ends most paths sooner)")
       ->capture_default_str();
   rendering->add_option("--rr-depth", o.rrDepth,

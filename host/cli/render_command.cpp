@@ -93,6 +93,7 @@ void chunkOf(const RenderOptions& o, RenderSettings& s) {
     throw Error("--passes '" + o.passes + "': give A:B, passes A to B-1 with 0 <= A < B (e.g. 0:64)");
   const std::pair<bool, const char*> clashes[] = {{o.spp.has_value(), "--spp (the chunk's end is its spp)"},
                                                   {o.noise > 0, "--noise"},
+                                                  {o.adaptive, "--adaptive"},
                                                   {!o.resume.empty(), "--resume"},
                                                   {!o.checkpoint.empty(), "--checkpoint (the chunk is the unit to rerun)"},
                                                   {!o.aov.empty(), "--aov"}};
@@ -134,6 +135,8 @@ RenderSettings settingsFrom(const RenderOptions& o) {
   if (!o.passes.empty()) chunkOf(o, s);
   s.seconds = o.seconds;
   s.noise = o.noise;
+  s.adaptive = o.adaptive;
+  if (o.adaptive && !o.aov.empty()) throw Error("--adaptive samples a render's noise; --aov renders a debug view");
   s.maxDepth = o.maxDepth;
   s.rrDepth = o.rrDepth;
   s.seed = o.seed;
@@ -219,7 +222,8 @@ int mpiRank(const RenderOptions& o) {
 // Under mpirun: what a render shared by ranks cannot do (yet), refused on every rank alike;
 // and one progress display, rank 0's (every rank's stderr reaches the terminal).
 void checkSharedRender(const RenderOptions& o, RenderSettings& settings, int rank) {
-  const std::pair<bool, const char*> clashes[] = {{o.noise > 0, "--noise"}, {!o.aov.empty(), "--aov"}};
+  const std::pair<bool, const char*> clashes[] = {
+      {o.noise > 0, "--noise"}, {o.adaptive, "--adaptive"}, {!o.aov.empty(), "--aov"}};
   for (const auto& [given, flag] : clashes)
     if (given) throw Error(std::string("under mpirun, ranks share a render without ") + flag + " (not yet supported)");
   settings.progress = rank == 0;
@@ -334,15 +338,18 @@ int runRender(RenderOptions o) {
     writeTextAtomically(o.statsFile, "--stats", statsJson(r.stats, settings) + "\n");
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // The film's samples per pixel: a noise target drops the passes finished past it.
-  const double spp = debugView ? double(r.stats.samples) / double(r.film.pixels()) : r.film.count(0);
+  // The film's samples per pixel (a noise target drops the passes finished past it), over
+  // the image: an adaptive render's pixels have counts of their own.
+  const double spp = debugView ? double(r.stats.samples) / double(r.film.pixels())
+                               : r.film.samples() / double(r.film.pixels());
   const double estimatedRelMse = debugView ? 0.0 : r.film.estimatedRelMse();
   std::map<std::string, std::string> metadata = imageMetadata(o, scene, r, method, spp, seconds, estimatedRelMse);
+  if (settings.adaptive) metadata["adaptive"] = "1";
   const Image image = r.film.imageWithLayers(layers);
-  const std::string passes = std::to_string(uint64_t(r.film.count(0))) + " passes";
+  const std::string passes = std::to_string(r.film.passes()) + " passes";
   if (r.stopped) {
     const int signal = settings.stop->load();
-    if (r.film.count(0) == 0) throw Interrupted("before any pass was finished; nothing written", signal);
+    if (r.film.samples() == 0) throw Interrupted("before any pass was finished; nothing written", signal);
     metadata["incomplete"] = "interrupted by signal " + std::to_string(signal);
     throw Interrupted("wrote the " + passes + " finished so far to " + writeOutputs(o, settings, r.film, image, metadata) +
                           (o.checkpoint.empty() ? "" : " and a checkpoint to " + o.checkpoint +

@@ -3,6 +3,7 @@
 #include "render/checkpoint.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <cstring>
@@ -18,8 +19,9 @@ namespace fh {
 namespace {
 
 // Version 2: the header lists the passes the film holds (chunks, ranks' films), and samples
-// are quantized (render/film.h).
-constexpr const char* kMagic = "fredholm-film-2";
+// are quantized (render/film.h). Version 3: the odd passes' sums carry their sample count
+// (an adaptive render's pixels have counts of their own).
+constexpr const char* kMagic = "fredholm-film-3";
 
 // FNV-1a, 64 bits, over whatever bytes are fed to it.
 class Fingerprint {
@@ -68,6 +70,7 @@ std::string renderFingerprint(const Scene& scene, const Camera& camera, const Re
   f.add(camera.eye).add(camera.target).add(camera.up).add(camera.fovYDeg);
   f.add(s.width).add(s.height).add(s.seed).add(s.method).add(s.maxDepth).add(s.rrDepth).add(s.env).add(s.filter);
   f.add(s.replicates()).add(s.surfaceAovs);
+  if (s.adaptive) f.add(s.adaptive);  // (renders that do not adapt keep their fingerprints)
   if (s.envMap) f.add(s.envMap->width).add(s.envMap->height).add(s.envMap->uShift()).add(s.envMap->texels);
   return f.hex();
 }
@@ -76,9 +79,11 @@ void saveFilm(const std::string& path, const Film& film, const std::string& fing
   std::ostringstream out;
   out << kMagic << ' ' << fingerprint << ' ' << film.width << ' ' << film.height << ' ' << film.passRanges().size();
   for (const auto& [begin, end] : film.passRanges()) out << ' ' << begin << ' ' << end;
-  out << ' ' << film.aovSum.size() << ' ' << film.oddSum.size() << '\n';
+  const size_t round = film.roundPixels ? film.roundPixels->size() : 0;
+  out << ' ' << film.aovSum.size() << ' ' << film.oddSum.size() << ' ' << round << '\n';
   for (const std::vector<double>* v : sums(film))
     out.write(reinterpret_cast<const char*>(v->data()), std::streamsize(v->size() * 8));
+  if (round) out.write(reinterpret_cast<const char*>(film.roundPixels->data()), std::streamsize(round * 4));
   writeTextAtomically(path, flag, out.str());
 }
 
@@ -91,7 +96,7 @@ SavedFilm readFilm(const std::string& path, const std::string& flag) {
   if (!in) throw Error(flag + " '" + path + "': cannot read the file");
   std::string magic, saved;
   int width = 0, height = 0;
-  size_t rangeCount = 0, aovs = 0, odd = 0;
+  size_t rangeCount = 0, aovs = 0, odd = 0, round = 0;
   const std::string notAFilm = flag + " '" + path + "': not a fredholm film or checkpoint";
   in >> magic >> saved >> width >> height >> rangeCount;
   if (!in || magic != kMagic || rangeCount > 4096) throw Error(notAFilm);
@@ -105,25 +110,38 @@ SavedFilm readFilm(const std::string& path, const std::string& flag) {
       throw Error(notAFilm);
     passes += ranges[i].second - ranges[i].first;
   }
-  in >> aovs >> odd;
+  in >> aovs >> odd >> round;
   if (!in || in.get() != '\n' || width <= 0 || height <= 0 || uint64_t(width) * uint64_t(height) > (uint64_t(1) << 28))
     throw Error(notAFilm);
   // The sums' sizes follow from the header: checked against the file before allocating.
   const uint64_t pixels = uint64_t(width) * uint64_t(height);
-  if ((aovs != 0 && aovs != pixels * kAovSumsPerPixel) || (odd != 0 && odd != pixels * 3)) throw Error(notAFilm);
+  if ((aovs != 0 && aovs != pixels * kAovSumsPerPixel) || (odd != 0 && odd != pixels * kOddSumsPerPixel) ||
+      round > pixels)
+    throw Error(notAFilm);
   const auto body = in.tellg();
   in.seekg(0, std::ios::end);
   const uint64_t bytes = uint64_t(in.tellg() - body);
   in.seekg(body);
-  if (bytes != (8 * pixels + aovs + odd) * 8) throw Error(flag + " '" + path + "': the file is cut short");
+  if (bytes != (8 * pixels + aovs + odd) * 8 + round * 4) throw Error(flag + " '" + path + "': the file is cut short");
   SavedFilm f{Film(width, height, aovs > 0, odd > 0, ranges.empty() ? 0 : ranges.front().first), saved};
   for (std::vector<double>* v : sums(f.film))
     if (!in.read(reinterpret_cast<char*>(v->data()), std::streamsize(v->size() * 8)))
       throw Error(flag + " '" + path + "': the file is cut short");
+  if (round) {
+    auto pixelList = std::make_shared<std::vector<uint32_t>>(round);
+    if (!in.read(reinterpret_cast<char*>(pixelList->data()), std::streamsize(round * 4)))
+      throw Error(flag + " '" + path + "': the file is cut short");
+    for (size_t i = 0; i < round; ++i)  // ascending pixel indices
+      if ((*pixelList)[i] >= pixels || (i > 0 && (*pixelList)[i] <= (*pixelList)[i - 1])) throw Error(notAFilm);
+    f.film.roundPixels = std::move(pixelList);
+  }
   if (in.peek() != std::char_traits<char>::eof()) throw Error(notAFilm);
-  // Every pass adds one sample to every pixel.
-  for (size_t p = 0; p < f.film.pixels(); ++p)
-    if (f.film.count(p) != double(passes)) throw Error(flag + " '" + path + "': the film's sample counts do not add up");
+  // Every pass adds one sample to each pixel it covers: every pixel, or an adaptive round's.
+  for (size_t p = 0; p < f.film.pixels(); ++p) {
+    const double n = f.film.count(p);
+    if (!(n >= 0 && n <= double(passes) && n == std::floor(n)))
+      throw Error(flag + " '" + path + "': the film's sample counts do not add up");
+  }
   f.film.setPassRanges(ranges);
   return f;
 }

@@ -3,6 +3,8 @@
 
 #include <string>
 
+#include "base/error.h"
+
 namespace fh {
 
 // Iterations queued between reads of the device's books: enough that the device is never
@@ -19,13 +21,18 @@ void DeviceWorker::run(const RenderSettings& settings) {
   }
 }
 
-// New passes while fewer than passSlots() are unfinished (and this device has room for them).
+// New passes while fewer than passSlots() are unfinished. A pass of another shape (an
+// adaptive round's pixels) comes only when none is in flight: the pipeline switches to it.
 void DeviceWorker::takePasses() {
   const uint64_t before = granted_;
-  uint32_t pass;
-  while (granted_ - returned_ < pipeline_.passSlots() && granted_ < pipeline_.passCapacity() &&
-         source_.take(index_, pass))
-    pipeline_.grantPass(granted_++, pass);
+  Pass pass;
+  while (granted_ - returned_ < pipeline_.passSlots() && source_.take(index_, pass)) {
+    if (pass.pixels != pipeline_.passPixels()) {
+      if (granted_ != returned_) throw Error("internal: a pass of another shape while passes are in flight");
+      pipeline_.setPassPixels(pass.pixels, granted_);
+    }
+    pipeline_.grantPass(granted_++, pass.index);
+  }
   if (granted_ != before) pipeline_.startGrantedPasses(granted_);
 }
 

@@ -22,7 +22,7 @@ void addEach(std::vector<double>& to, const std::vector<double>& from) {
 
 Film::Film(int w, int h, bool surfaceAovs, bool twoReplicates, uint64_t firstPass)
     : width(w), height(h), sum(pixels() * 4, 0.0), sumSq(pixels() * 4, 0.0),
-      aovSum(surfaceAovs ? pixels() * kAovSumsPerPixel : 0, 0.0), oddSum(twoReplicates ? pixels() * 3 : 0, 0.0),
+      aovSum(surfaceAovs ? pixels() * kAovSumsPerPixel : 0, 0.0), oddSum(twoReplicates ? pixels() * kOddSumsPerPixel : 0, 0.0),
       firstPass_(firstPass) {}
 
 void Film::merge(const Film& other) {
@@ -78,7 +78,7 @@ void Film::addPass(uint64_t pass, const std::vector<float>& samples) {
   }
   if (!oddSum.empty() && pass % 2 == 1)
     for (size_t p = 0; p < pixels(); ++p)
-      for (size_t c = 0; c < 3; ++c) oddSum[3 * p + c] += quantized(samples[4 * p + c]);
+      for (size_t c = 0; c < 4; ++c) oddSum[kOddSumsPerPixel * p + c] += quantized(samples[4 * p + c]);
   held_.emplace_back(pass, pass + 1);
   setPassRanges(held_);
   if (!hasSurfaceAovs()) return;
@@ -98,28 +98,33 @@ void Film::addPass(uint64_t pass, const std::vector<float>& samples) {
 }
 
 double Film::estimatedRelMse() const {
-  const bool replicated = !oddSum.empty() && passes_ >= 2;
-  // The mean of nEven and nOdd passes: its variance is D^2 nEven nOdd / n^2 in expectation,
-  // D the difference of the halves' means (each half's variance proportional to 1 / count).
-  double nOdd = 0.0;
-  for (const auto& [begin, end] : held_) nOdd += double(end / 2 - begin / 2);  // odd passes in [begin, end)
-  const double nEven = double(passes_) - nOdd;
   double total = 0.0;
   for (size_t p = 0; p < pixels(); ++p) {
     const double n = count(p);
     if (n <= 0) continue;
+    // The mean of nEven and nOdd samples: its variance is D^2 nEven nOdd / n^2 in
+    // expectation, D the difference of the halves' means (each half's variance proportional
+    // to 1 / count). A pixel's counts are its own: an adaptive render's passes skip pixels.
+    const double nOdd = oddSum.empty() ? 0.0 : oddSum[kOddSumsPerPixel * p + 3], nEven = n - nOdd;
+    const bool replicated = nOdd > 0 && nEven > 0;
     const std::array<double, 3> variance = varianceOfMean(p);
     for (size_t c = 0; c < 3; ++c) {
       const double mean = sum[4 * p + c] / n;
       double error = variance[c];
       if (replicated) {
-        const double odd = oddSum[3 * p + c], d = (sum[4 * p + c] - odd) / nEven - odd / nOdd;
+        const double odd = oddSum[kOddSumsPerPixel * p + c], d = (sum[4 * p + c] - odd) / nEven - odd / nOdd;
         error = d * d * nEven * nOdd / (n * n);
       }
       total += error / (mean * mean + kRelMseEpsilon);
     }
   }
   return pixels() ? total / double(3 * pixels()) : 0.0;
+}
+
+double Film::samples() const {
+  double total = 0.0;
+  for (size_t p = 0; p < pixels(); ++p) total += count(p);
+  return total;
 }
 
 // Channels first .. first + 2 of the layer sums, over each pixel's samples.

@@ -13,6 +13,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -21,6 +22,8 @@
 
 namespace fh {
 
+// The film's sums of the odd passes per pixel, with two replicates: rgb and the sample count.
+constexpr size_t kOddSumsPerPixel = 4;
 // A pass's first-surface layers per pixel, after its radiance (kernels/aovs.h): albedo rgb,
 // a flag, normal xyz, the camera ray's hit distance.
 constexpr size_t kAovFloatsPerPixel = 8;
@@ -36,8 +39,8 @@ struct Film {
   // pass the film starts at (a chunk's, --passes A:B; else 0).
   Film(int w, int h, bool surfaceAovs = false, bool twoReplicates = false, uint64_t firstPass = 0);
 
-  // Adds pass `pass` (one the film does not hold): per pixel (rgb, 1), pixel-major, as the
-  // device's pass buffer holds it, then, for a film with surface AOVs, kAovFloatsPerPixel
+  // Adds pass `pass` (one the film does not hold): per pixel (rgb, 1) where the pass covers
+  // the pixel and zeros elsewhere, pixel-major, as the device's pass buffer holds it, then, for a film with surface AOVs, kAovFloatsPerPixel
   // per pixel.
   void addPass(uint64_t pass, const std::vector<float>& samples);
   // Adds the pass after the last one held (firstPass for an empty film).
@@ -76,6 +79,8 @@ struct Film {
   // Whether the film holds passes firstPass() .. nextPass() - 1 and no others.
   bool consecutive() const { return held_.size() <= 1; }
   double count(size_t pixel) const { return sum[4 * pixel + 3]; }
+  // Samples over all pixels (every pixel's count: an adaptive render's differ).
+  double samples() const;
   size_t pixels() const { return size_t(width) * size_t(height); }
 
   // The first-surface layers, means per pixel: albedo and normal over all samples (zero
@@ -90,8 +95,11 @@ struct Film {
   std::vector<double> sum, sumSq;
   // Per pixel: albedo rgb, normal xyz, depth, samples that hit (sums in pass order).
   std::vector<double> aovSum;
-  // With two replicates: per pixel, the rgb sums of the odd passes.
+  // With two replicates: per pixel, the rgb sums of the odd passes and their sample count.
   std::vector<double> oddSum;
+  // An adaptive render's film (render/adaptive.h): the pixels its last round's passes cover,
+  // so a render resumed from it mid-round goes on with that round; null: every pixel.
+  std::shared_ptr<const std::vector<uint32_t>> roundPixels;
 
  private:
   std::vector<float> aovMean(size_t first) const;

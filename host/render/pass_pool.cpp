@@ -5,6 +5,8 @@
 #include <csignal>
 #include <cstdlib>
 
+#include "base/error.h"
+#include "render/adaptive.h"
 #include "render/checkpoint.h"
 
 namespace fh {
@@ -14,9 +16,18 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
 }
 }  // namespace
 
+namespace {
+// The passes a render may number: global sample pass * pixels + pixel is 32 bits (an
+// adaptive render's passes cover fewer pixels, so it may have more than spp of them).
+uint32_t passLimit(const RenderSettings& s) {
+  return s.adaptive ? uint32_t(0xFFFFFFFFull / (uint64_t(s.width) * uint64_t(s.height)))
+                    : uint32_t(std::max(1, s.spp));
+}
+}  // namespace
+
 PassPool::PassPool(const RenderSettings& s, int workers)
     : settings_(s),
-      total_(uint32_t(std::max(1, s.spp))),
+      total_(passLimit(s)),
       start_(std::chrono::steady_clock::now()),
       outstanding_(size_t(workers)),
       done_(size_t(workers), 0),
@@ -26,6 +37,22 @@ PassPool::PassPool(const RenderSettings& s, int workers)
   // A resumed render goes on from the first pass its film lacks; a chunk starts at its first.
   next_ = nextToMerge_ = uint32_t(film_.nextPass());
   merged_ = film_.passes();
+  mergedSamples_ = film_.samples();
+  samplesDone_.assign(size_t(workers), 0);
+  round_ = {total_, nullptr, film_.pixels()};
+  if (s.adaptive) {
+    sampleBudget_ = uint64_t(std::max(1, s.spp)) * film_.pixels();
+    samplesHanded_ = uint64_t(mergedSamples_);
+    // A film that ends mid-round (past the first) says which pixels the round covers.
+    const uint32_t begin = adaptiveRoundBegin(next_);
+    const bool midRound = begin != next_ && begin >= kAdaptiveFirstRound;
+    if (midRound && !film_.roundPixels)
+      throw Error("--resume: the film ends in an adaptive round (at pass " + std::to_string(next_) +
+                  ") and does not say which pixels it covers");
+    std::shared_ptr<const PixelList> pixels = midRound ? film_.roundPixels : adaptivePixels(film_, begin);
+    if (pixels && pixels->size() == film_.pixels()) pixels = nullptr;
+    openRound(begin, pixels);
+  }
   // ... unless it met its noise target already (a render that stopped there).
   noiseReached_ = s.resume && s.noise > 0.0 && film_.passes() >= kNoiseMinPasses &&
                   film_.estimatedRelMse() <= s.noise;
@@ -51,7 +78,7 @@ bool PassPool::outOfTime() const { return settings_.seconds > 0.0 && secondsSinc
 // but other workers still have passes in flight, a worker with none of its own waits: if
 // one of them fails, its passes come back here and must find a worker still running. (A
 // worker with passes of its own never waits; it asks again after its next batch.)
-bool PassPool::take(int worker, uint32_t& pass) {
+bool PassPool::take(int worker, Pass& pass) {
   std::unique_lock<std::mutex> lock(mutex_);
   if (!started_) {  // the time budget counts from the first pass handed out
     start_ = std::chrono::steady_clock::now();
@@ -60,31 +87,41 @@ bool PassPool::take(int worker, uint32_t& pass) {
   for (;;) {
     if (settings_.stopRequested()) return false;
     if (!requeued_.empty()) {
-      pass = requeued_.front();
+      pass.index = requeued_.front();
       requeued_.pop_front();
       break;
     }
     if (noiseReached_) return false;
-    if (nextNewPass(pass)) break;
-    if (!outstanding_[size_t(worker)].empty() || !anyOutstanding()) return false;
+    const NewPass next = nextNewPass(pass.index);
+    if (next == NewPass::Given) break;
+    const bool mine = !outstanding_[size_t(worker)].empty();
+    if (mine || (next == NewPass::None && !anyOutstanding())) return false;
     changed_.wait(lock);
   }
-  outstanding_[size_t(worker)].insert(pass);
+  // Every pass handed out is of the current round: a round opens once all before it are in.
+  pass.pixels = round_.pixels;
+  outstanding_[size_t(worker)].insert(pass.index);
   return true;
 }
 
 // A pass no one has rendered yet: from the ledger where processes share the render, else
-// the next in this process's count, while the sample count and the time budget allow.
-bool PassPool::nextNewPass(uint32_t& pass) {
+// the next in this process's count, while the sample count (an adaptive render's sample
+// budget) and the time budget allow; Later at the end of an adaptive round.
+PassPool::NewPass PassPool::nextNewPass(uint32_t& pass) {
   if (settings_.ledger) {
-    if (ledgerDry_) return false;
-    if (settings_.ledger->next(pass)) return true;
+    if (ledgerDry_) return NewPass::None;
+    if (settings_.ledger->next(pass)) return NewPass::Given;
     ledgerDry_ = true;  // ask no more: for another process, each question is a message
-    return false;
+    return NewPass::None;
   }
-  if (next_ >= total_ || outOfTime()) return false;
+  if (next_ >= total_ || outOfTime()) return NewPass::None;
+  if (settings_.adaptive) {
+    if (next_ == round_.end) return NewPass::Later;
+    if (samplesHanded_ + round_.size > sampleBudget_) return NewPass::None;
+    samplesHanded_ += round_.size;
+  }
   pass = next_++;
-  return true;
+  return NewPass::Given;
 }
 
 // Hands the samples over (the worker gets a spare buffer back) and returns at once.
@@ -92,6 +129,7 @@ void PassPool::done(int worker, uint32_t pass, std::vector<float>& samples) {
   std::lock_guard<std::mutex> lock(mutex_);
   outstanding_[size_t(worker)].erase(pass);
   ++done_[size_t(worker)];
+  samplesDone_[size_t(worker)] += round_.size;  // a pass of the current round
   pending_[pass].swap(samples);
   if (!spare_.empty()) {
     samples.swap(spare_.back());
@@ -112,6 +150,11 @@ uint64_t PassPool::passesDone(int worker) const {
   return done_[size_t(worker)];
 }
 
+uint64_t PassPool::samplesDone(int worker) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return samplesDone_[size_t(worker)];
+}
+
 Film PassPool::finish(bool& complete) {
   stopMerging();
   std::lock_guard<std::mutex> lock(mutex_);
@@ -121,11 +164,25 @@ Film PassPool::finish(bool& complete) {
     if (noiseReached_) break;  // beyond the pass that met the target
     film_.addPass(pass, samples);
     ++merged_;
+    mergedSamples_ += double(round_.size);
   }
   pending_.clear();
   if (settings_.ledger) progress_.end();  // other processes may still be rendering
-  else progress_.finish(merged_ * film_.pixels(), secondsSince(start_));
+  else progress_.finish(uint64_t(mergedSamples_), secondsSince(start_));
   return film_;
+}
+
+// The adaptive round from pass `begin` on covers `pixels` (null: every pixel). The film
+// records them for a checkpoint saved during the round, every pixel listed too, so that a
+// render resumed from it knows the round whatever it covers.
+void PassPool::openRound(uint32_t begin, std::shared_ptr<const PixelList> pixels) {
+  round_ = {adaptiveRoundEnd(begin), pixels, pixels ? pixels->size() : film_.pixels()};
+  if (!pixels && begin >= kAdaptiveFirstRound) {
+    auto every = std::make_shared<PixelList>(film_.pixels());
+    for (size_t p = 0; p < every->size(); ++p) (*every)[p] = uint32_t(p);
+    pixels = std::move(every);
+  }
+  film_.roundPixels = std::move(pixels);
 }
 
 bool PassPool::anyOutstanding() const {
@@ -154,10 +211,19 @@ void PassPool::mergeInOrder() {
     const bool check = settings_.noise > 0.0 && film_.passes() >= kNoiseMinPasses;
     const double estimate = check ? film_.estimatedRelMse() : -1.0;
     if (settings_.ledger) settings_.ledger->finished(pass);
+    // The last pass of an adaptive round: the film holds every pass before the next round,
+    // which its pixels are chosen from (round_ is written by this thread alone).
+    const bool roundEnds = settings_.adaptive && pass + 1 == round_.end;
+    const auto nextPixels = roundEnds ? adaptivePixels(film_, round_.end) : nullptr;
     lock.lock();
     spare_.push_back(std::move(samples));
     ++nextToMerge_;
     ++merged_;
+    mergedSamples_ += double(round_.size);
+    if (roundEnds) {
+      openRound(round_.end, nextPixels);
+      changed_.notify_all();  // workers wait for the round
+    }
     checkpoint(false);
     if (check) noiseEstimate_ = estimate;
     showProgress();
@@ -195,7 +261,8 @@ void PassPool::showProgress() {
   const double noiseShare = noiseEstimate_ > 0.0 ? std::min(1.0, settings_.noise / noiseEstimate_) : 0.0;
   const uint64_t passes = total_ - settings_.firstPass;  // this render's, or this chunk's
   const uint64_t elsewhere = settings_.ledger ? settings_.ledger->finishedElsewhere() : 0;
-  progress_.update((merged_ + elsewhere) * film_.pixels(), timed || noisy ? 0 : passes * film_.pixels(), elapsed,
+  const uint64_t samples = settings_.adaptive ? sampleBudget_ : passes * film_.pixels();
+  progress_.update(uint64_t(mergedSamples_) + elsewhere * film_.pixels(), timed || noisy ? 0 : samples, elapsed,
                    noisy ? std::min(1.0, std::max(noiseShare, timed ? elapsed / settings_.seconds : 0.0))
                          : timed ? std::min(1.0, elapsed / settings_.seconds) : 0.0);
 }

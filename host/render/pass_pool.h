@@ -6,11 +6,16 @@
 // A noise target is checked on the film after each merged pass, so the render ends with the
 // first pass count whose film meets it: passes finished beyond it are dropped, and the image
 // for a seed and target is the same whichever devices rendered and however fast.
+//
+// An adaptive render's passes come in rounds (render/adaptive.h): the merger chooses a
+// round's pixels once every earlier pass is in the film, and workers wait for it. Its
+// sample count is a budget: spp times the pixels, over whichever pixels the rounds cover.
 #pragma once
 #include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <set>
 #include <string>
@@ -30,11 +35,12 @@ class PassPool : public PassSource {
   PassPool(const RenderSettings& s, int workers);
   ~PassPool() override;
 
-  bool take(int worker, uint32_t& pass) override;
+  bool take(int worker, Pass& pass) override;
   void done(int worker, uint32_t pass, std::vector<float>& samples) override;
   void fail(int worker) override;
 
   uint64_t passesDone(int worker) const;
+  uint64_t samplesDone(int worker) const;
   // Ends the render: saves the checkpoint (the passes merged in order), merges whatever
   // finished out of order (passes lost with every device leave gaps: the film records which
   // passes it holds), closes the progress display, and returns the film. `complete` is
@@ -45,7 +51,9 @@ class PassPool : public PassSource {
 
  private:
   bool anyOutstanding() const;
-  bool nextNewPass(uint32_t& pass);
+  enum class NewPass { Given, Later, None };  // Later: once the merger opens the next round
+  NewPass nextNewPass(uint32_t& pass);
+  void openRound(uint32_t begin, std::shared_ptr<const PixelList> pixels);
   bool outOfTime() const;
   void mergeInOrder();
   void stopMerging();
@@ -60,6 +68,16 @@ class PassPool : public PassSource {
   bool started_ = false;
   uint32_t next_ = 0, nextToMerge_ = 0;
   uint64_t merged_ = 0;
+  double mergedSamples_ = 0;
+  // The passes handed out now cover these pixels, up to pass `end` (every pixel and every
+  // pass but in an adaptive render).
+  struct Round {
+    uint32_t end = 0;
+    std::shared_ptr<const PixelList> pixels;  // null: every pixel
+    size_t size = 0;                          // pixels covered
+  } round_;
+  uint64_t sampleBudget_ = 0, samplesHanded_ = 0;  // an adaptive render's
+  std::vector<uint64_t> samplesDone_;
   std::deque<uint32_t> requeued_;
   std::vector<std::set<uint32_t>> outstanding_;
   std::vector<uint64_t> done_;

@@ -1,19 +1,32 @@
-// Where a render's passes come from and where finished ones go. A pass is one sample per
-// pixel; global pass k seeds its samples, so a pass is the same image whichever device
-// renders it. Device workers take passes, render them and hand them back; the source
-// merges them into one film in pass order. Called from the workers' threads.
+// Where a render's passes come from and where finished ones go. A pass is one sample for
+// each pixel it covers: every pixel, or in an adaptive render the pixels of its round
+// (render/adaptive.h); global pass k seeds its samples, so a pass is the same image
+// whichever device renders it. Device workers take passes, render them and hand them
+// back; the source merges them into one film in pass order. Called from the workers' threads.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace fh {
 
+// The pixels a pass covers, ascending pixel indices; shared by the passes of a round.
+using PixelList = std::vector<uint32_t>;
+
+struct Pass {
+  uint32_t index = 0;
+  std::shared_ptr<const PixelList> pixels;  // null: every pixel
+};
+
 class PassSource {
  public:
   virtual ~PassSource() = default;
-  // The next pass for `worker`; false when the render needs no more from it.
-  virtual bool take(int worker, uint32_t& pass) = 0;
-  // A finished pass's samples: rgb and 1 per pixel, pixel-major (may be swapped out).
+  // The next pass for `worker`; false when the render needs no more from it. Passes that
+  // cover other pixels than the worker's last are handed out only once every earlier pass
+  // is back, so a device never has passes of two shapes in flight.
+  virtual bool take(int worker, Pass& pass) = 0;
+  // A finished pass's samples: rgb and 1 per pixel it covers (zeros elsewhere),
+  // pixel-major (may be swapped out).
   virtual void done(int worker, uint32_t pass, std::vector<float>& samples) = 0;
   // The worker stopped: the passes it had taken must be rendered by others.
   virtual void fail(int worker) = 0;

@@ -127,7 +127,7 @@ class Render {
     const auto lastEnd = *std::max_element(ends_.begin(), ends_.end());
     for (size_t i = 0; i < devices_.size(); ++i) {
       auto& share = st.devices[i];
-      share.samples = pool_.passesDone(int(i)) * result.film.pixels();
+      share.samples = pool_.samplesDone(int(i));
       share.idleSeconds = std::chrono::duration<double>(lastEnd - ends_[i]).count();  // waiting for the last
       st.samples += share.samples;
       st.add(counts_[i]);

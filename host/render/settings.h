@@ -47,6 +47,9 @@ struct RenderSettings {
   // The sampler's independently scrambled sequences (RenderParams::replicates): two under a
   // noise target, whose difference is its error estimate; else one.
   unsigned replicates() const { return noise > 0.0 ? 2 : 1; }
+  // --adaptive: after a first round over every pixel, passes cover the pixels where the
+  // error is (render/adaptive.h); spp is then the average over the image, a budget.
+  bool adaptive = false;
   Method method = Method::MIS;
   int maxDepth = 64;     // bounces; Russian roulette does the real work
   // Russian roulette from this bounce on: later than the minimum because roulette adds

@@ -118,13 +118,19 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
   params_ = renderParams(s, camera, scene_, filterTable);
   // Enough passes in flight that the wavefront stays full while a pass's longest paths
   // finish: pass buffers cost a frame each, so only as many as the wavefront needs.
-  passSlots_ = unsigned(std::min<size_t>(FH_MAX_PASS_SLOTS, 2 + (2 * wavefront_ + pixels_ - 1) / pixels_));
-  // Every pass this device may render: at most spp of them (a time budget stops earlier).
-  const uint64_t maxPasses = uint64_t(std::max(1, s.spp));
-  if (maxPasses * pixels_ >= (uint64_t(1) << 32))
+  // An adaptive render's passes may cover few pixels: as many in flight as there may be.
+  passSlots_ = s.adaptive ? FH_MAX_PASS_SLOTS
+                          : unsigned(std::min<size_t>(FH_MAX_PASS_SLOTS, 2 + (2 * wavefront_ + pixels_ - 1) / pixels_));
+  // Global sample numbers are 32 bits: at most spp passes (a time budget stops earlier; an
+  // adaptive render's passes cover fewer pixels, and its pool counts them).
+  if (uint64_t(std::max(1, s.spp)) * pixels_ >= (uint64_t(1) << 32))
     throw Error("--spp " + std::to_string(s.spp) + " at " + std::to_string(s.width) + "x" + std::to_string(s.height) +
                 " is more than 2^32 samples in one render; render fewer");
-  passTable_.assign(maxPasses, 0);
+  passTable_.assign(passSlots_, 0);
+  everyPixel_.resize(pixels_);
+  for (uint32_t p = 0; p < pixels_; ++p) everyPixel_[p] = p;
+  passShape_ = {pixels_, 0, 0};
+  counters_.pass_pixels = pixels_;
 
   const cl::Program program = buildProgram(
       dc.context, dc.info.device, pathTracerProgram(scene_.features, s.method, passSlots_, scene_.bvh.traversalOptions(),
@@ -160,11 +166,13 @@ void WavefrontPipeline::allocateBuffers(const std::vector<float>& filterTable) {
   queues_.counters = buffer(sizeof counters_, "queue counters", &counters_);
   passBuffers_ = buffer(size_t(passSlots_) * pixels_ * 16, "pass buffers");
   FH_CL(dc_.queue.enqueueFillBuffer(passBuffers_, 0u, 0, size_t(passSlots_) * pixels_ * 16));
-  // Every sample writes its AOV entry at its first vertex: no clearing needed.
+  // Every sample writes its AOV entry at its first vertex; takePass clears a slot's for
+  // pixels the next pass may not cover.
   aovBuffers_ = buffer(surfaceAovs_ ? size_t(passSlots_) * pixels_ * kAovFloatsPerPixel * 4 : 16, "AOV buffers");
   filterTable_ = allocateBuffer(dc_.context, dc_.info.device, CL_MEM_READ_ONLY, filterTable.size() * 4,
                                 "filter table", filterTable.data());
   passTableBuffer_ = buffer(passTable_.size() * 4, "pass table");
+  pixelListBuffer_ = buffer(size_t(pixels_) * 4, "pixel list", everyPixel_.data());
 }
 
 // Every argument of every stage, for one parity. The argument lists follow the kernels'
@@ -181,13 +189,13 @@ void WavefrontPipeline::bindArguments(unsigned parity) {
   if (isMegakernel(strategy_)) {
     ArgumentList(megakernels_[parity])
         << params_ << queues_.counters << parity << queues_.freeSlots << filterTable_ << passTableBuffer_
-        << sc.bvh.nodes() << sc.bvh.blocks() << sc.bvh.triangles() << sc.triangleMaterial << sc.materials
-        << sc.lightCdf << sc.lightTriangle << sc.lightPdfArea << sc.normals << sc.uvs << sc.texels << sc.textureInfo
+        << pixelListBuffer_ << sc.bvh.nodes() << sc.bvh.blocks() << sc.bvh.triangles() << sc.triangleMaterial
+        << sc.materials << sc.lightCdf << sc.lightTriangle << sc.lightPdfArea << sc.normals << sc.uvs << sc.texels << sc.textureInfo
         << sc.environment << passBuffers_ << aovBuffers_ << paths_;
     return;
   }
   args(Stage::Generate) << params_ << queues_.counters << queues_.freeSlots << rays << filterTable_
-                        << passTableBuffer_ << paths_;
+                        << passTableBuffer_ << pixelListBuffer_ << paths_;
   args(Stage::Intersect) << sc.bvh.nodes() << sc.bvh.blocks() << rays << queues_.counters << parity
                          << paths_.ray_org << paths_.ray_dir << paths_.hit;
   args(Stage::Shade) << params_ << rays << nextRays << queues_.finished << queues_.counters << parity
@@ -235,14 +243,26 @@ void WavefrontPipeline::writeCounter(size_t offset, const uint32_t& value) {
 }
 
 void WavefrontPipeline::grantPass(uint64_t local, uint32_t global) {
-  passTable_[local] = global;  // stable storage: the write is asynchronous
-  FH_CL(dc_.queue.enqueueWriteBuffer(passTableBuffer_, CL_FALSE, local * 4, 4, &passTable_[local]));
+  const size_t entry = size_t(local % passSlots_);  // free: its last pass was returned
+  passTable_[entry] = global;                       // stable storage: the write is asynchronous
+  FH_CL(dc_.queue.enqueueWriteBuffer(passTableBuffer_, CL_FALSE, entry * 4, 4, &passTable_[entry]));
+}
+
+void WavefrontPipeline::setPassPixels(std::shared_ptr<const PixelList> pixels, uint64_t granted) {
+  passPixels_ = std::move(pixels);
+  const std::vector<uint32_t>& list = passPixels_ ? *passPixels_ : everyPixel_;
+  if (list.empty() || list.size() > pixels_) throw Error("internal: a pass of no pixels, or of too many");
+  // Nothing is in flight: every sample granted so far has started (sampleLimit_).
+  passShape_ = {uint32_t(list.size()), sampleLimit_, uint32_t(granted)};
+  FH_CL(dc_.queue.enqueueWriteBuffer(pixelListBuffer_, CL_FALSE, 0, list.size() * 4, list.data()));
+  FH_CL(dc_.queue.enqueueWriteBuffer(queues_.counters, CL_FALSE, offsetof(gpu::WavefrontCounters, pass_pixels),
+                                     sizeof passShape_, passShape_.data()));
 }
 
 void WavefrontPipeline::startGrantedPasses(uint64_t granted) {
   // sampleLimit_ is the source of an asynchronous write: it is set once per batch, after the
   // previous batch's write has completed (readCounters waits for the queue).
-  sampleLimit_ = uint32_t(granted * pixels_);
+  sampleLimit_ = passShape_[1] + uint32_t(granted - passShape_[2]) * passShape_[0];
   writeCounter(offsetof(gpu::WavefrontCounters, sample_limit), sampleLimit_);
 }
 
@@ -259,7 +279,7 @@ const gpu::WavefrontCounters& WavefrontPipeline::readCounters() {
 }
 
 bool WavefrontPipeline::passComplete(uint64_t local) const {
-  return counters_.pass_done[local % passSlots_] == pixels_;
+  return counters_.pass_done[local % passSlots_] == passShape_[0];
 }
 
 void WavefrontPipeline::takePass(uint64_t local, std::vector<float>& samples) {
@@ -269,7 +289,9 @@ void WavefrontPipeline::takePass(uint64_t local, std::vector<float>& samples) {
   if (aovBytes)
     FH_CL(dc_.queue.enqueueReadBuffer(aovBuffers_, CL_FALSE, slot * aovBytes, aovBytes, samples.data() + bytes / 4));
   FH_CL(dc_.queue.enqueueReadBuffer(passBuffers_, CL_TRUE, slot * bytes, bytes, samples.data()));
+  // Pixels a pass does not cover (an adaptive round's) must read as no sample: zeros.
   FH_CL(dc_.queue.enqueueFillBuffer(passBuffers_, 0u, slot * bytes, bytes));
+  if (aovBytes) FH_CL(dc_.queue.enqueueFillBuffer(aovBuffers_, 0u, slot * aovBytes, aovBytes));
   // Safe to reset: the next pass using this slot has not been granted yet.
   static const uint32_t zero = 0;
   writeCounter(offsetof(gpu::WavefrontCounters, pass_done) + slot * 4, zero);

@@ -7,12 +7,14 @@
 #include <array>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "kernels/path_state.h"
 #include "render/device_scene.h"
 #include "render/film.h"
+#include "render/pass_source.h"
 #include "render/render_stats.h"
 #include "render/settings.h"
 #include "render/stages.h"
@@ -76,11 +78,14 @@ class WavefrontPipeline {
   // Passes are numbered locally (0, 1, ... on this device) and mapped to global passes,
   // which seed the samples. At most passSlots() granted passes may be unfinished.
   unsigned passSlots() const { return passSlots_; }
-  uint64_t passCapacity() const { return passTable_.size(); }
   void grantPass(uint64_t local, uint32_t global);
+  // The pixels the passes cover (null: every pixel), from local pass `granted` on; set only
+  // when no granted pass is unfinished.
+  void setPassPixels(std::shared_ptr<const PixelList> pixels, uint64_t granted);
+  const std::shared_ptr<const PixelList>& passPixels() const { return passPixels_; }
   // Lets local passes 0 .. granted-1 start; once per batch, after its grants.
   void startGrantedPasses(uint64_t granted);
-  uint32_t globalPass(uint64_t local) const { return passTable_[local]; }
+  uint32_t globalPass(uint64_t local) const { return passTable_[local % passSlots_]; }
 
   // Waits for the queued iterations and reads the books back.
   const gpu::WavefrontCounters& readCounters();
@@ -127,11 +132,17 @@ class WavefrontPipeline {
   PathStateBuffers paths_;
   ShadowRequestBuffers shadowRequests_;
   SlotQueues queues_;
-  cl::Buffer passBuffers_, filterTable_, passTableBuffer_;
+  cl::Buffer passBuffers_, filterTable_, passTableBuffer_, pixelListBuffer_;
   bool surfaceAovs_;
   cl::Buffer aovBuffers_;  // per pass slot and pixel, kernels/aovs.h (a placeholder without AOVs)
-  std::vector<uint32_t> passTable_;  // global pass of each local pass (stable storage for writes)
-  uint32_t sampleLimit_ = 0;         // local samples that may start (stable storage for writes)
+  // Global pass of each local pass in flight, by local pass % passSlots_ (stable storage for writes).
+  std::vector<uint32_t> passTable_;
+  uint32_t sampleLimit_ = 0;  // local samples that may start (stable storage for writes)
+  // The passes' shape: the pixels they cover (null: all, listed in everyPixel_), and
+  // WavefrontCounters' pass_pixels, round_first_sample, round_first_pass (stable storage).
+  std::shared_ptr<const PixelList> passPixels_;
+  std::vector<uint32_t> everyPixel_;
+  std::array<uint32_t, 3> passShape_{};
   gpu::WavefrontCounters counters_{};
   // Every stage's kernel twice, bound once for each parity: an iteration sets nothing.
   std::array<std::array<cl::Kernel, kStages.size()>, 2> kernels_;
