@@ -8,16 +8,18 @@
 
 // The shape of the passes in flight (WavefrontCounters::pass_pixels and after), read once.
 typedef struct {
-  uint pixels, first_sample, first_pass;
+  uint pixels, first_sample, first_pass, ring;
 } PassShape;
-#define FH_PASS_SHAPE(counters) \
-  ((PassShape){(counters)->pass_pixels, (counters)->round_first_sample, (counters)->round_first_pass})
+#define FH_PASS_SHAPE(counters)                                                                   \
+  ((PassShape){(counters)->pass_pixels, (counters)->round_first_sample, (counters)->round_first_pass, \
+               (counters)->pass_ring})
 
 // Starts device sample j (a device numbers its samples locally) in path slot `slot`. Its
 // passes are granted by the host, which may hand different passes to different devices:
 // from the shape's first sample on, every shape.pixels samples are one local pass, whose
-// global pass is in pass_table (a ring of FH_PASS_SLOTS entries: a pass's entry is reused
-// once it is returned), and sample i of a pass renders pixel_list[i]. Global sample
+// global pass is in pass_table (a ring of shape.ring entries, the pass slots: a slot is
+// reused once its pass is returned), and sample i of a pass renders pixel_list[i] into
+// entry i of its slot's pass buffer (pass_entry). Global sample
 // k = pass * pixel_count + pixel seeds the random numbers, so a sample is the same
 // whichever device renders it, and the pixel's samples are its passes' points of one
 // sequence whichever passes cover it.
@@ -25,9 +27,10 @@ FH_INLINE void start_sample(RenderParams params, PassShape shape, luint j, luint
                             __global const float* filter_table, __global const uint* pass_table,
                             __global const uint* pixel_list FH_PATH_PARAMS) {
   const luint in_round = j - shape.first_sample;
-  const luint device_pass = shape.first_pass + in_round / shape.pixels;
-  const luint pixel = gather_uint(pixel_list, in_round % shape.pixels);
-  const luint pass = gather_uint(pass_table, device_pass % FH_PASS_SLOTS);
+  const luint pass_slot = (shape.first_pass + in_round / shape.pixels) % shape.ring;
+  const luint index = in_round % shape.pixels;
+  const luint pixel = gather_uint(pixel_list, index);
+  const luint pass = gather_uint(pass_table, pass_slot);
   const luint k = pass * params.pixel_count + pixel;
   const PixelSampler sampler = pixel_sampler(params.seed, k, params.pixel_count, params.replicates);
   const lvec2 u = sample_2d(&sampler, (luint)(FH_DIM_PIXEL));
@@ -40,7 +43,7 @@ FH_INLINE void start_sample(RenderParams params, PassShape shape, luint j, luint
   scatter_float(ray_pdf, slot, (lfloat)(0.0f), active);
   scatter_xyzw(radiance, slot, v3_splat(0.0f), (lfloat)(0.0f), active);
   scatter_uint(sample_id, slot, k, active);
-  scatter_uint(local_pass, slot, device_pass, active);
+  scatter_uint(pass_entry, slot, pass_slot * shape.pixels + index, active);
   scatter_uint(depth, slot, (luint)(0), active);
 }
 

@@ -25,9 +25,9 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
                          __global float4* aovs FH_PATH_PARAMS) {
   // The work-group's books, added to the device's once at the end (see queue_append_each):
   // samples finished per pass slot, then bounce rays, shadow rays and non-finite samples.
-  volatile __local uint finished_in_slot[FH_PASS_SLOTS], totals[3];
+  volatile __local uint finished_in_slot[FH_MAX_PASS_SLOTS], totals[3];
   const uint lid = get_local_id(0);
-  if (lid < FH_PASS_SLOTS) finished_in_slot[lid] = 0;
+  if (lid < FH_MAX_PASS_SLOTS) finished_in_slot[lid] = 0;
   if (lid < 3) totals[lid] = 0;
   barrier(CLK_LOCAL_MEM_FENCE);
 
@@ -63,7 +63,7 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
       bounce_rays += lanes_count(o.continues);
       if (lanes_any(o.finished)) {
         luint slot;
-        const lmask finite = record_samples(p, o.finished, params.pixel_count, pass_buffer, &slot FH_PATH_ARGS);
+        const lmask finite = record_samples(p, o.finished, shape.pixels, pass_buffer, &slot FH_PATH_ARGS);
         FH_FOR_LANES(l) {
           if (LANE(o.finished, l)) atomic_inc(&finished_in_slot[LANE(slot, l)]);
         }
@@ -76,7 +76,7 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
     if (nonfinite) atomic_add(&totals[2], nonfinite);
   }
   barrier(CLK_LOCAL_MEM_FENCE);
-  if (lid < FH_PASS_SLOTS && finished_in_slot[lid]) atomic_add(&counters->pass_done[lid], finished_in_slot[lid]);
+  if (lid < FH_MAX_PASS_SLOTS && finished_in_slot[lid]) atomic_add(&counters->pass_done[lid], finished_in_slot[lid]);
   if (lid == 0) {
     if (totals[0]) atomic_add(&counters->ray_length[1 - parity], totals[0]);
     if (totals[1]) atomic_add(&counters->shadow_length, totals[1]);

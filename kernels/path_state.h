@@ -15,7 +15,7 @@
   X(float, ray_pdf, 4)          /* pdf with which the BSDF sampled ray_dir (MIS); < 0: delta */ \
   X(float4, radiance, 16)       /* rgb gathered so far */                                        \
   X(uint, sample_id, 4)         /* global sample index: pixel = id % pixels, pass = id / pixels */ \
-  X(uint, local_pass, 4)        /* this device's pass number for the sample: its pass buffer */    \
+  X(uint, pass_entry, 4)        /* the sample's entry in the pass buffers: slot, pixel's index */   \
   X(uint, depth, 4)             /* bounces so far */
 
 // The light-sample requests shade hands to shadow_connect, stored by queue position (so
@@ -95,11 +95,6 @@ FH_INLINE ShadowRequest load_shadow_request(luint index FH_SHADOW_PARAMS) {
   r.depth = gather_uint(shadow_depth, index);
   return r;
 }
-#endif
-
-// Passes in flight on a device: pass p uses pass-buffer slot p % FH_PASS_SLOTS.
-#ifndef FH_PASS_SLOTS
-#define FH_PASS_SLOTS FH_MAX_PASS_SLOTS
 #endif
 
 #endif

@@ -103,7 +103,7 @@ FH_INLINE ShadeOutcome shade_paths(RenderParams params, luint p, lmask active, _
     }
 #endif
 #if defined(FH_AOVS)
-    const luint aov = aov_entry(p, params.pixel_count, sample_id, local_pass);
+    const luint aov = aov_entry(p, pass_entry);
     record_escaped_aovs(aov, escaped && bounce == 0, aovs);
 #endif
 

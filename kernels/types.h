@@ -89,7 +89,7 @@ typedef struct {
 // keeps its own books (iteration.cl), so the host can queue many iterations without
 // waiting for any: it reads this back only now and then. 64-bit totals are (low, high)
 // pairs, as OpenCL 1.2 has no 64-bit atomics to rely on.
-#define FH_MAX_PASS_SLOTS 8  // passes in flight at most (the host picks FH_PASS_SLOTS <= this)
+#define FH_MAX_PASS_SLOTS 32  // passes in flight at most (WavefrontCounters::pass_ring <= this)
 typedef struct {
   uint ray_length[2];    // the two ray queues; the iteration's parity says which is current
   uint shadow_length;    // light-sample requests this iteration
@@ -109,10 +109,12 @@ typedef struct {
   // The passes in flight share one shape: each covers pass_pixels pixels, those listed
   // first in the pixel list (every pixel, or an adaptive round's, render/adaptive.h); the
   // shape's first pass starts at local sample round_first_sample and is local pass
-  // round_first_pass. The host sets them when no pass is in flight.
+  // round_first_pass; local pass p uses pass slot p % pass_ring, whose pass buffer holds
+  // pass_pixels entries, one per pixel listed. The host sets them when no pass is in flight.
   uint pass_pixels;
   uint round_first_sample;
   uint round_first_pass;
+  uint pass_ring;
   uint pass_done[FH_MAX_PASS_SLOTS];  // per pass slot: paths finished in the pass it holds
 } WavefrontCounters;
 

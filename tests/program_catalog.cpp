@@ -15,23 +15,23 @@ std::vector<ProgramSpec> everyProgramVariant() {
     for (unsigned bits = 0; bits < 16; ++bits)
       for (Strategy strategy : {Strategy::Scalar, Strategy::Simd8}) {
         const SceneFeatures features{(bits & 1) != 0, (bits & 2) != 0, (bits & 4) != 0, (bits & 8) != 0};
-        programs.push_back(pathTracerProgram(features, method, FH_MAX_PASS_SLOTS, traversal, strategy));
+        programs.push_back(pathTracerProgram(features, method, traversal, strategy));
       }
   // The environment map (FH_ENV_MAP) alone; all() below includes it with every material feature.
   for (Method method : {Method::PT, Method::NEE, Method::MIS})
     for (Strategy strategy : {Strategy::Scalar, Strategy::Simd8}) {
       SceneFeatures features;
       features.environmentMap = true;
-      programs.push_back(pathTracerProgram(features, method, FH_MAX_PASS_SLOTS, traversal, strategy));
+      programs.push_back(pathTracerProgram(features, method, traversal, strategy));
     }
   // The megakernel calls the same stage code: no features and all of them are enough.
   for (Method method : {Method::PT, Method::NEE, Method::MIS})
     for (const SceneFeatures& features : {SceneFeatures{}, SceneFeatures::all()})
-      programs.push_back(pathTracerProgram(features, method, FH_MAX_PASS_SLOTS, traversal, Strategy::Megakernel));
+      programs.push_back(pathTracerProgram(features, method, traversal, Strategy::Megakernel));
   // Recording the --aovs layers (FH_AOVS), with and without the features shade branches on.
   for (Strategy strategy : {Strategy::Scalar, Strategy::Megakernel8})
     for (const SceneFeatures& features : {SceneFeatures{}, SceneFeatures::all()})
-      programs.push_back(pathTracerProgram(features, Method::PT, FH_MAX_PASS_SLOTS, traversal, strategy, true));
+      programs.push_back(pathTracerProgram(features, Method::PT, traversal, strategy, true));
   return programs;
 }
 

@@ -109,7 +109,7 @@ TEST(AdaptivePixels, NoPixelFallsTooFarBehind) {
   ASSERT_NE(pixels, nullptr);
   // 16 of 256 samples: not yet behind. The round is pixel 0's neighbourhood alone (fewer
   // than kAdaptiveMinShare: no pixel without noise is taken to fill it).
-  EXPECT_EQ(pixels->size(), 16u);
+  EXPECT_EQ(pixels->size(), 9u);
   EXPECT_EQ(pixels->front(), 0u);
   EXPECT_FALSE(std::binary_search(pixels->begin(), pixels->end(), uint32_t(film.pixels() - 1)));
   samples[0] = samples[1] = samples[2] = 1.f;

@@ -118,10 +118,13 @@ TEST(Mpi, CtrlCWritesThePassesFinishedSoFar) {
 
 TEST(Mpi, WhatRanksCannotShareIsAOneLineErrorThatEndsTheJob) {
   const std::string dir = test::tempDir("mpi-refused");
-  const auto r = mpirun(2, kRender + "--noise 1e-2 -o " + dir + "/n.exr");
-  EXPECT_NE(r.exitCode, 0);
-  EXPECT_NE(r.output.find("fredholm: error: under mpirun, ranks share a render without --noise"), std::string::npos)
-      << r.output;
+  for (const std::string flag : {"--noise 1e-2", "--adaptive"}) {
+    const auto r = mpirun(2, kRender + flag + " -o " + dir + "/n.exr");
+    EXPECT_NE(r.exitCode, 0);
+    const std::string error =
+        "fredholm: error: under mpirun, ranks share a render without " + flag.substr(0, flag.find(' '));
+    EXPECT_NE(r.output.find(error), std::string::npos) << r.output;
+  }
   // Every rank's only device fails: the first error ends the job, nothing waits for ever.
   const auto failed = mpirun(2, kRender + "--spp 16 -o " + dir + "/f.exr", "FREDHOLM_FAIL_DEVICE=0:0");
   EXPECT_NE(failed.exitCode, 0);

@@ -55,7 +55,7 @@ FH_LAYOUT(RenderParams, env_height, 132);
 FH_LAYOUT(RenderParams, env_u_shift, 136);
 FH_LAYOUT(RenderParams, env_pick, 140);
 
-static_assert(sizeof(WavefrontCounters) == 120, "WavefrontCounters");
+static_assert(sizeof(WavefrontCounters) == 220, "WavefrontCounters");
 FH_LAYOUT(WavefrontCounters, ray_length, 0);
 FH_LAYOUT(WavefrontCounters, shadow_length, 8);
 FH_LAYOUT(WavefrontCounters, finished_length, 12);
@@ -74,7 +74,8 @@ FH_LAYOUT(WavefrontCounters, iterations, 72);
 FH_LAYOUT(WavefrontCounters, pass_pixels, 76);
 FH_LAYOUT(WavefrontCounters, round_first_sample, 80);
 FH_LAYOUT(WavefrontCounters, round_first_pass, 84);
-FH_LAYOUT(WavefrontCounters, pass_done, 88);
+FH_LAYOUT(WavefrontCounters, pass_ring, 88);
+FH_LAYOUT(WavefrontCounters, pass_done, 92);
 
 #undef FH_LAYOUT
 

@@ -28,10 +28,11 @@ std::vector<double> errorFallPerSample(const Film& film) {
   return fall;
 }
 
-// The mean over each pixel's 5x5 block (a pixel's own estimate, from a few dozen samples,
-// is too noisy to rank pixels by: the noisiest-looking would be the luckiest draws; and one
-// firefly is shared out, not followed), then the largest such mean over its 3x3
-// neighbourhood: a pixel beside a noisy block is sampled with it.
+// The mean over each pixel's 3x3 block (a pixel's own estimate, from a few dozen samples,
+// is a noisy ranking: the noisiest-looking are partly the luckiest draws; and one firefly is
+// shared out, not followed), then the largest such mean over its 3x3 neighbourhood: a pixel
+// beside a noisy block is sampled with it. (5x5 blocks ranked worse where the noise is
+// fine-grained, as on the Veach plates: bench/RESULTS.md.)
 std::vector<double> smoothed(const std::vector<double>& v, int width, int height) {
   const auto at = [width](int x, int y) { return size_t(y) * size_t(width) + size_t(x); };
   // Along x, then along y: `reduce` over the pixels within `radius`, clipped at the edges.
@@ -56,7 +57,7 @@ std::vector<double> smoothed(const std::vector<double>& v, int width, int height
     }
     return out;
   };
-  return pass(pass(v, 2, true), 1, false);
+  return pass(pass(v, 1, true), 1, false);
 }
 
 // The value `share` of the way up the sorted values (0.999: all but the top thousandth).

@@ -33,9 +33,10 @@ constexpr uint32_t kAdaptiveMaxSpread = 16;
 constexpr uint32_t kAdaptiveMinShare = 8;  // one pixel in 8
 
 // A round covers some pixels only where a sample there takes this many times more error off
-// than a sample of every pixel's would, on average (else it covers every pixel). On the
-// Cornell box, rounds predicted to gain twice gained nothing at equal time (bench/RESULTS.md).
-constexpr double kAdaptiveLeastGain = 3.0;
+// than a sample of every pixel's would, on average (else it covers every pixel): a round of
+// some pixels costs more per sample (their paths are longer, its passes smaller), and on
+// scenes noisy everywhere, such as the Cornell box, smaller gains did not pay (bench/RESULTS.md).
+constexpr double kAdaptiveLeastGain = 1.5;
 
 // The end of the round that starts at pass `begin` (a round boundary).
 uint32_t adaptiveRoundEnd(uint32_t begin);
@@ -44,7 +45,7 @@ uint32_t adaptiveRoundBegin(uint32_t pass);
 
 // The pixels the round starting at pass `begin` covers, chosen from `film`, which holds
 // passes 0 .. begin - 1: null (every pixel) for the first round; else the pixels whose
-// error falls fastest per sample (relative variance over count, averaged over a 5x5 block,
+// error falls fastest per sample (relative variance over count, averaged over a 3x3 block,
 // then the largest over 3x3, so a pixel whose samples missed a light its neighbours found
 // is not dropped), down to a quarter of the busiest's: those that, after their samples
 // double, still lose error as fast as the busiest do now. Null again where they would gain

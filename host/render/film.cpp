@@ -70,21 +70,20 @@ std::string Film::describePasses() const {
   return d.empty() ? "none" : d;
 }
 
-void Film::addPass(uint64_t pass, const std::vector<float>& samples) {
-  for (size_t i = 0; i < sum.size(); ++i) {
-    const double v = quantized(samples[i]);
-    sum[i] += v;
-    if (i % 4 != 3) sumSq[i] += v * v;
-  }
-  if (!oddSum.empty() && pass % 2 == 1)
-    for (size_t p = 0; p < pixels(); ++p)
-      for (size_t c = 0; c < 4; ++c) oddSum[kOddSumsPerPixel * p + c] += quantized(samples[4 * p + c]);
-  held_.emplace_back(pass, pass + 1);
-  setPassRanges(held_);
-  if (!hasSurfaceAovs()) return;
-  const float* aovs = samples.data() + sum.size();
-  for (size_t p = 0; p < pixels(); ++p) {
-    const float* in = aovs + kAovFloatsPerPixel * p;  // albedo rgb, flag, normal xyz, distance
+void Film::addPass(uint64_t pass, const std::vector<float>& samples, const std::vector<uint32_t>* covered) {
+  const size_t count = covered ? covered->size() : pixels();
+  const bool odd = !oddSum.empty() && pass % 2 == 1;
+  const float* aovs = samples.data() + 4 * count;
+  for (size_t i = 0; i < count; ++i) {
+    const size_t p = covered ? (*covered)[i] : i;
+    for (size_t c = 0; c < 4; ++c) {
+      const double v = quantized(samples[4 * i + c]);
+      sum[4 * p + c] += v;
+      if (c != 3) sumSq[4 * p + c] += v * v;
+      if (odd) oddSum[kOddSumsPerPixel * p + c] += v;
+    }
+    if (!hasSurfaceAovs()) continue;
+    const float* in = aovs + kAovFloatsPerPixel * i;  // albedo rgb, flag, normal xyz, distance
     double* out = &aovSum[kAovSumsPerPixel * p];
     for (size_t c = 0; c < 3; ++c) {
       out[c] += quantized(in[c]);
@@ -95,6 +94,8 @@ void Film::addPass(uint64_t pass, const std::vector<float>& samples) {
       out[7] += 1.0;
     }
   }
+  held_.emplace_back(pass, pass + 1);
+  setPassRanges(held_);
 }
 
 double Film::estimatedRelMse() const {

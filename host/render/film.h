@@ -39,10 +39,10 @@ struct Film {
   // pass the film starts at (a chunk's, --passes A:B; else 0).
   Film(int w, int h, bool surfaceAovs = false, bool twoReplicates = false, uint64_t firstPass = 0);
 
-  // Adds pass `pass` (one the film does not hold): per pixel (rgb, 1) where the pass covers
-  // the pixel and zeros elsewhere, pixel-major, as the device's pass buffer holds it, then, for a film with surface AOVs, kAovFloatsPerPixel
-  // per pixel.
-  void addPass(uint64_t pass, const std::vector<float>& samples);
+  // Adds pass `pass` (one the film does not hold): (rgb, 1) for each pixel it covers, in
+  // order (every pixel, or those `covered` lists: an adaptive round's), as the device's pass
+  // buffer holds them, then, for a film with surface AOVs, kAovFloatsPerPixel for each.
+  void addPass(uint64_t pass, const std::vector<float>& samples, const std::vector<uint32_t>* covered = nullptr);
   // Adds the pass after the last one held (firstPass for an empty film).
   void addPass(const std::vector<float>& samples) { addPass(nextPass(), samples); }
   // Adds another film's passes: a chunk of the same render. Exact but for sumSq. Throws

@@ -162,7 +162,7 @@ Film PassPool::finish(bool& complete) {
   complete = noiseReached_ || (pending_.empty() && requeued_.empty() && !anyOutstanding());
   for (auto& [pass, samples] : pending_) {
     if (noiseReached_) break;  // beyond the pass that met the target
-    film_.addPass(pass, samples);
+    film_.addPass(pass, samples, round_.pixels.get());
     ++merged_;
     mergedSamples_ += double(round_.size);
   }
@@ -207,7 +207,7 @@ void PassPool::mergeInOrder() {
     const uint32_t pass = next->first;
     pending_.erase(next);
     lock.unlock();
-    film_.addPass(pass, samples);
+    film_.addPass(pass, samples, round_.pixels.get());  // the pass's round: it is the merger's to change
     const bool check = settings_.noise > 0.0 && film_.passes() >= kNoiseMinPasses;
     const double estimate = check ? film_.estimatedRelMse() : -1.0;
     if (settings_.ledger) settings_.ledger->finished(pass);

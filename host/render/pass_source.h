@@ -25,8 +25,8 @@ class PassSource {
   // cover other pixels than the worker's last are handed out only once every earlier pass
   // is back, so a device never has passes of two shapes in flight.
   virtual bool take(int worker, Pass& pass) = 0;
-  // A finished pass's samples: rgb and 1 per pixel it covers (zeros elsewhere),
-  // pixel-major (may be swapped out).
+  // A finished pass's samples: rgb and 1 for each pixel it covers, in order (may be
+  // swapped out).
   virtual void done(int worker, uint32_t pass, std::vector<float>& samples) = 0;
   // The worker stopped: the passes it had taken must be rendered by others.
   virtual void fail(int worker) = 0;

@@ -11,6 +11,8 @@ namespace fh {
 namespace {
 
 constexpr int kFilterTableSize = 256;
+// Passes of every pixel in flight at most (each costs a frame of pass buffers).
+constexpr size_t kMostFullPasses = 8;
 
 // Sets a kernel's arguments in the order they are given, so no call site counts indices.
 class ArgumentList {
@@ -69,15 +71,14 @@ SceneFeatures featuresFor(const Scene& scene, const RenderSettings& s) {
   return f;
 }
 
-ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsigned passSlots,
-                              const std::string& traversalOptions, Strategy strategy, bool surfaceAovs) {
+ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, const std::string& traversalOptions,
+                              Strategy strategy, bool surfaceAovs) {
   const char* methodFlag = method == Method::PT ? "PT" : method == Method::NEE ? "NEE" : "MIS";
   const bool mega = isMegakernel(strategy);
   return {std::string("path tracer (") + methodName(method) + features.buildOptions() + ", " + strategyName(strategy) +
               (surfaceAovs ? ", aovs" : "") + ")",
           mega ? std::vector<std::string>{stageInfo(Stage::PlanIteration).file, kMegakernel.file} : stageFiles(),
-          traversalOptions + features.buildOptions() + " -DFH_PASS_SLOTS=" + std::to_string(passSlots) +
-              " -DFH_METHOD_" + methodFlag + " -DFH_LANES=" + std::to_string(lanesOf(strategy)) +
+          traversalOptions + features.buildOptions() + " -DFH_METHOD_" + methodFlag + " -DFH_LANES=" + std::to_string(lanesOf(strategy)) +
               (mega ? " -DFH_MEGAKERNEL" : "") + (surfaceAovs ? " -DFH_AOVS" : "")};
 }
 
@@ -112,28 +113,29 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
       pixels_(unsigned(s.width) * unsigned(s.height)),
       surfaceAovs_(s.surfaceAovs) {
   // No more paths than the passes in flight can ever hold.
-  const size_t most = roundUp(size_t(FH_MAX_PASS_SLOTS) * pixels_, kLocalSize);
+  const size_t most = roundUp(size_t(kMostFullPasses) * pixels_, kLocalSize);
   wavefront_ = std::min(s.wavefront ? s.wavefront : defaultWavefront(dc.info, pixels_), most);
   std::vector<float> filterTable;
   params_ = renderParams(s, camera, scene_, filterTable);
-  // Enough passes in flight that the wavefront stays full while a pass's longest paths
-  // finish: pass buffers cost a frame each, so only as many as the wavefront needs.
-  // An adaptive render's passes may cover few pixels: as many in flight as there may be.
-  passSlots_ = s.adaptive ? FH_MAX_PASS_SLOTS
-                          : unsigned(std::min<size_t>(FH_MAX_PASS_SLOTS, 2 + (2 * wavefront_ + pixels_ - 1) / pixels_));
+  // Enough passes of every pixel in flight that the wavefront stays full while a pass's
+  // longest paths finish: each costs a frame of pass buffers, so only as many as the
+  // wavefront needs. Passes of fewer pixels (an adaptive round's) fit more times.
+  const size_t fullPasses = std::min<size_t>(kMostFullPasses, 2 + (2 * wavefront_ + pixels_ - 1) / pixels_);
+  passEntries_ = fullPasses * pixels_;
   // Global sample numbers are 32 bits: at most spp passes (a time budget stops earlier; an
   // adaptive render's passes cover fewer pixels, and its pool counts them).
   if (uint64_t(std::max(1, s.spp)) * pixels_ >= (uint64_t(1) << 32))
     throw Error("--spp " + std::to_string(s.spp) + " at " + std::to_string(s.width) + "x" + std::to_string(s.height) +
                 " is more than 2^32 samples in one render; render fewer");
-  passTable_.assign(passSlots_, 0);
+  passTable_.assign(FH_MAX_PASS_SLOTS, 0);
   everyPixel_.resize(pixels_);
   for (uint32_t p = 0; p < pixels_; ++p) everyPixel_[p] = p;
-  passShape_ = {pixels_, 0, 0};
+  passShape_ = {pixels_, 0, 0, uint32_t(fullPasses)};
   counters_.pass_pixels = pixels_;
+  counters_.pass_ring = uint32_t(fullPasses);
 
   const cl::Program program = buildProgram(
-      dc.context, dc.info.device, pathTracerProgram(scene_.features, s.method, passSlots_, scene_.bvh.traversalOptions(),
+      dc.context, dc.info.device, pathTracerProgram(scene_.features, s.method, scene_.bvh.traversalOptions(),
                                                          strategy_, surfaceAovs_));
   // The megakernel's program holds only the books' kernels besides its own: its stages are
   // functions it calls (a kernel per stage would double PoCL's compile time for nothing).
@@ -164,11 +166,10 @@ void WavefrontPipeline::allocateBuffers(const std::vector<float>& filterTable) {
   queues_.freeSlots = buffer(wavefront_ * 4, "free list", allFree.data());
   counters_.free_length = unsigned(wavefront_);
   queues_.counters = buffer(sizeof counters_, "queue counters", &counters_);
-  passBuffers_ = buffer(size_t(passSlots_) * pixels_ * 16, "pass buffers");
-  FH_CL(dc_.queue.enqueueFillBuffer(passBuffers_, 0u, 0, size_t(passSlots_) * pixels_ * 16));
-  // Every sample writes its AOV entry at its first vertex; takePass clears a slot's for
-  // pixels the next pass may not cover.
-  aovBuffers_ = buffer(surfaceAovs_ ? size_t(passSlots_) * pixels_ * kAovFloatsPerPixel * 4 : 16, "AOV buffers");
+  // Every sample of a pass writes its entries (radiance; first-surface layers at its first
+  // vertex): no clearing needed.
+  passBuffers_ = buffer(passEntries_ * 16, "pass buffers");
+  aovBuffers_ = buffer(surfaceAovs_ ? passEntries_ * kAovFloatsPerPixel * 4 : 16, "AOV buffers");
   filterTable_ = allocateBuffer(dc_.context, dc_.info.device, CL_MEM_READ_ONLY, filterTable.size() * 4,
                                 "filter table", filterTable.data());
   passTableBuffer_ = buffer(passTable_.size() * 4, "pass table");
@@ -205,8 +206,7 @@ void WavefrontPipeline::bindArguments(unsigned parity) {
   args(Stage::ShadowConnect) << params_ << queues_.counters << sc.bvh.nodes() << sc.bvh.blocks()
                              << sc.bvh.triangles() << sc.triangleMaterial << sc.materials << sc.lightCdf
                              << sc.lightTriangle << sc.lightPdfArea << sc.environment << paths_ << shadowRequests_;
-  args(Stage::Accumulate) << queues_.finished << queues_.counters << queues_.freeSlots << pixels_ << passBuffers_
-                          << paths_;
+  args(Stage::Accumulate) << queues_.finished << queues_.counters << queues_.freeSlots << passBuffers_ << paths_;
 }
 
 // Each stage is launched over the whole wavefront and reads its queue's length on the
@@ -243,7 +243,7 @@ void WavefrontPipeline::writeCounter(size_t offset, const uint32_t& value) {
 }
 
 void WavefrontPipeline::grantPass(uint64_t local, uint32_t global) {
-  const size_t entry = size_t(local % passSlots_);  // free: its last pass was returned
+  const size_t entry = size_t(local % passSlots());  // free: its last pass was returned
   passTable_[entry] = global;                       // stable storage: the write is asynchronous
   FH_CL(dc_.queue.enqueueWriteBuffer(passTableBuffer_, CL_FALSE, entry * 4, 4, &passTable_[entry]));
 }
@@ -253,7 +253,8 @@ void WavefrontPipeline::setPassPixels(std::shared_ptr<const PixelList> pixels, u
   const std::vector<uint32_t>& list = passPixels_ ? *passPixels_ : everyPixel_;
   if (list.empty() || list.size() > pixels_) throw Error("internal: a pass of no pixels, or of too many");
   // Nothing is in flight: every sample granted so far has started (sampleLimit_).
-  passShape_ = {uint32_t(list.size()), sampleLimit_, uint32_t(granted)};
+  const size_t ring = std::min<size_t>(FH_MAX_PASS_SLOTS, passEntries_ / list.size());
+  passShape_ = {uint32_t(list.size()), sampleLimit_, uint32_t(granted), uint32_t(ring)};
   FH_CL(dc_.queue.enqueueWriteBuffer(pixelListBuffer_, CL_FALSE, 0, list.size() * 4, list.data()));
   FH_CL(dc_.queue.enqueueWriteBuffer(queues_.counters, CL_FALSE, offsetof(gpu::WavefrontCounters, pass_pixels),
                                      sizeof passShape_, passShape_.data()));
@@ -279,19 +280,17 @@ const gpu::WavefrontCounters& WavefrontPipeline::readCounters() {
 }
 
 bool WavefrontPipeline::passComplete(uint64_t local) const {
-  return counters_.pass_done[local % passSlots_] == passShape_[0];
+  return counters_.pass_done[local % passSlots()] == passShape_[0];
 }
 
 void WavefrontPipeline::takePass(uint64_t local, std::vector<float>& samples) {
-  const size_t slot = size_t(local % passSlots_), bytes = size_t(pixels_) * 16;
-  const size_t aovBytes = surfaceAovs_ ? size_t(pixels_) * kAovFloatsPerPixel * 4 : 0;
-  samples.resize((bytes + aovBytes) / 4);
-  if (aovBytes)
-    FH_CL(dc_.queue.enqueueReadBuffer(aovBuffers_, CL_FALSE, slot * aovBytes, aovBytes, samples.data() + bytes / 4));
-  FH_CL(dc_.queue.enqueueReadBuffer(passBuffers_, CL_TRUE, slot * bytes, bytes, samples.data()));
-  // Pixels a pass does not cover (an adaptive round's) must read as no sample: zeros.
-  FH_CL(dc_.queue.enqueueFillBuffer(passBuffers_, 0u, slot * bytes, bytes));
-  if (aovBytes) FH_CL(dc_.queue.enqueueFillBuffer(aovBuffers_, 0u, slot * aovBytes, aovBytes));
+  const size_t slot = size_t(local % passSlots()), count = passShape_[0];
+  const size_t aovFloats = surfaceAovs_ ? kAovFloatsPerPixel : 0;
+  samples.resize(count * (4 + aovFloats));
+  if (aovFloats)
+    FH_CL(dc_.queue.enqueueReadBuffer(aovBuffers_, CL_FALSE, slot * count * aovFloats * 4, count * aovFloats * 4,
+                                      samples.data() + count * 4));
+  FH_CL(dc_.queue.enqueueReadBuffer(passBuffers_, CL_TRUE, slot * count * 16, count * 16, samples.data()));
   // Safe to reset: the next pass using this slot has not been granted yet.
   static const uint32_t zero = 0;
   writeCounter(offsetof(gpu::WavefrontCounters, pass_done) + slot * 4, zero);

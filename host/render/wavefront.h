@@ -44,12 +44,10 @@ struct SlotQueues {
   cl::Buffer finished, freeSlots, counters;
 };
 
-// The path tracer's program for a scene's features, a method, the passes in flight and a
-// strategy (the paths each work-item carries, FH_LANES; for the megakernels, the books and
+// The path tracer's program for a scene's features, a method and a strategy (the paths each work-item carries, FH_LANES; for the megakernels, the books and
 // megakernel.cl instead of the stage files); with surfaceAovs, shade records the
 // first-surface layers (FH_AOVS).
-ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, unsigned passSlots,
-                              const std::string& traversalOptions, Strategy strategy, bool surfaceAovs = false);
+ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, const std::string& traversalOptions, Strategy strategy, bool surfaceAovs = false);
 
 // The features a render's kernels are compiled with: the scene's (or all of them with
 // --all-features), and the environment map if the render has one.
@@ -76,8 +74,9 @@ class WavefrontPipeline {
   void enqueueIteration();
 
   // Passes are numbered locally (0, 1, ... on this device) and mapped to global passes,
-  // which seed the samples. At most passSlots() granted passes may be unfinished.
-  unsigned passSlots() const { return passSlots_; }
+  // which seed the samples. At most passSlots() granted passes may be unfinished: as many
+  // as the pass buffers hold passes of the current shape.
+  unsigned passSlots() const { return passShape_[3]; }
   void grantPass(uint64_t local, uint32_t global);
   // The pixels the passes cover (null: every pixel), from local pass `granted` on; set only
   // when no granted pass is unfinished.
@@ -85,14 +84,14 @@ class WavefrontPipeline {
   const std::shared_ptr<const PixelList>& passPixels() const { return passPixels_; }
   // Lets local passes 0 .. granted-1 start; once per batch, after its grants.
   void startGrantedPasses(uint64_t granted);
-  uint32_t globalPass(uint64_t local) const { return passTable_[local % passSlots_]; }
+  uint32_t globalPass(uint64_t local) const { return passTable_[local % passSlots()]; }
 
   // Waits for the queued iterations and reads the books back.
   const gpu::WavefrontCounters& readCounters();
   // Whether local pass `local` is complete, as of the last readCounters().
   bool passComplete(uint64_t local) const;
-  // Reads a complete pass's samples (rgb, 1 per pixel; then, with surface AOVs, the pass's
-  // kAovFloatsPerPixel per pixel) and frees its slot for a new pass.
+  // Reads a complete pass's samples (rgb, 1 for each pixel it covers, in the order of its
+  // pixel list; then, with surface AOVs, kAovFloatsPerPixel for each) and frees its slot.
   void takePass(uint64_t local, std::vector<float>& samples);
 
   // This device's counts so far (samples are the film's to count) and stage times.
@@ -127,7 +126,8 @@ class WavefrontPipeline {
   DeviceScene scene_;
   gpu::RenderParams params_{};
   size_t wavefront_;
-  unsigned pixels_, passSlots_;
+  unsigned pixels_;
+  size_t passEntries_;  // the pass buffers' entries: enough for a few passes of every pixel
   unsigned parity_ = 0;  // which ray queue is current
   PathStateBuffers paths_;
   ShadowRequestBuffers shadowRequests_;
@@ -135,14 +135,15 @@ class WavefrontPipeline {
   cl::Buffer passBuffers_, filterTable_, passTableBuffer_, pixelListBuffer_;
   bool surfaceAovs_;
   cl::Buffer aovBuffers_;  // per pass slot and pixel, kernels/aovs.h (a placeholder without AOVs)
-  // Global pass of each local pass in flight, by local pass % passSlots_ (stable storage for writes).
+  // Global pass of each local pass in flight, by local pass % passSlots() (stable storage for writes).
   std::vector<uint32_t> passTable_;
   uint32_t sampleLimit_ = 0;  // local samples that may start (stable storage for writes)
   // The passes' shape: the pixels they cover (null: all, listed in everyPixel_), and
-  // WavefrontCounters' pass_pixels, round_first_sample, round_first_pass (stable storage).
+  // WavefrontCounters' pass_pixels, round_first_sample, round_first_pass, pass_ring
+  // (stable storage for writes).
   std::shared_ptr<const PixelList> passPixels_;
   std::vector<uint32_t> everyPixel_;
-  std::array<uint32_t, 3> passShape_{};
+  std::array<uint32_t, 4> passShape_{};
   gpu::WavefrontCounters counters_{};
   // Every stage's kernel twice, bound once for each parity: an iteration sets nothing.
   std::array<std::array<cl::Kernel, kStages.size()>, 2> kernels_;
