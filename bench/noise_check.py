@@ -6,7 +6,7 @@ and taken off), then renders stopped by --noise at each target with two seeds; p
 estimate when the render stopped, the relMSE measured against the reference (minus the
 reference's own), their ratio, spp and seconds, as a Markdown table.
 
-  bench/noise_check.py --scene SCENE.obj --size 96x64 --ref-spp 16384 --targets 1e-2,3e-3
+  bench/noise_check.py --scene SCENE.obj --size 96x64 --ref-spp 16384 --targets 1e-2,3e-3 [--adaptive]
 """
 import argparse
 import json
@@ -39,6 +39,7 @@ def main():
     p.add_argument("--ref-spp", type=int, default=4096)
     p.add_argument("--targets", default="1e-2,3e-3,1e-3")
     p.add_argument("--seeds", default="1,2")
+    p.add_argument("--adaptive", action="store_true", help="the stopped renders sample adaptively")
     a = p.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         ref = os.path.join(tmp, "ref.exr")
@@ -51,7 +52,8 @@ def main():
         for target in a.targets.split(","):
             for seed in a.seeds.split(","):
                 out = os.path.join(tmp, "img.exr")
-                meta, _ = render(a.binary, a.scene, a.size, out, ["--noise", target, "--seed", seed])
+                flags = ["--noise", target, "--seed", seed] + (["--adaptive"] if a.adaptive else [])
+                meta, _ = render(a.binary, a.scene, a.size, out, flags)
                 cmp = json.loads(subprocess.run([a.binary, "compare", out, ref], check=True, capture_output=True,
                                                 text=True).stdout)
                 estimate, measured = float(meta["estimated_relmse"]), cmp["relmse"] - ref_error

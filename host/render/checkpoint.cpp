@@ -136,10 +136,11 @@ SavedFilm readFilm(const std::string& path, const std::string& flag) {
     f.film.roundPixels = std::move(pixelList);
   }
   if (in.peek() != std::char_traits<char>::eof()) throw Error(notAFilm);
-  // Every pass adds one sample to each pixel it covers: every pixel, or an adaptive round's.
+  // Every pass adds one sample to each pixel it covers: every pixel, but in an adaptive
+  // render's film (one that lists its round's pixels), whose pixels have counts of their own.
   for (size_t p = 0; p < f.film.pixels(); ++p) {
     const double n = f.film.count(p);
-    if (!(n >= 0 && n <= double(passes) && n == std::floor(n)))
+    if (round ? !(n >= 0 && n <= double(passes) && n == std::floor(n)) : n != double(passes))
       throw Error(flag + " '" + path + "': the film's sample counts do not add up");
   }
   f.film.setPassRanges(ranges);
