@@ -73,7 +73,8 @@ TEST(AdaptivePixels, ARoundTakesTheNoisyPixelsAndTheirNeighbours) {
 
 // Noise everywhere alike: choosing would not pay, and the round covers every pixel.
 TEST(AdaptivePixels, EvenNoiseKeepsEveryPixel) {
-  const Film film = filmOf(32, 32, 16, [](int x, int y) { return std::make_pair(1.f, 0.3f + 0.01f * float((x + y) % 3)); });
+  const Film film =
+      filmOf(32, 32, 16, [](int x, int y) { return std::make_pair(1.f, 0.3f + 0.01f * float((x + y) % 3)); });
   EXPECT_EQ(adaptivePixels(film, 16), nullptr);
 }
 

@@ -35,7 +35,8 @@ std::vector<double> errorFallPerSample(const Film& film) {
 // fine-grained, as on the Veach plates: bench/RESULTS.md.)
 std::vector<double> smoothed(const std::vector<double>& v, int width, int height) {
   const auto at = [width](int x, int y) { return size_t(y) * size_t(width) + size_t(x); };
-  // Along x, then along y: `reduce` over the pixels within `radius`, clipped at the edges.
+  // Along x, then along y: the mean (or the largest) of the pixels within `radius`, clipped
+  // at the edges.
   const auto pass = [&](const std::vector<double>& in, int radius, bool mean) {
     std::vector<double> across(in.size()), out(in.size());
     for (int dir = 0; dir < 2; ++dir) {
@@ -92,16 +93,14 @@ std::shared_ptr<const PixelList> adaptivePixels(const Film& film, uint32_t begin
   double most = 0.0;
   for (size_t p = 0; p < film.pixels(); ++p) most = std::max(most, film.count(p));
   std::vector<char> chosen(film.pixels(), 0);
-  size_t taken = 0;
-  for (size_t p = 0; p < film.pixels(); ++p) {
+  for (size_t p = 0; p < film.pixels(); ++p)
     chosen[p] = (fall[p] > 0.0 && fall[p] >= threshold) || film.count(p) * kAdaptiveMaxSpread < most;
-    taken += size_t(chosen[p]);
-  }
+  const auto taken = [&] { return size_t(std::count(chosen.begin(), chosen.end(), char(1))); };
   // Too few for a full wavefront: the next most deserving too (ties by pixel index), of
   // those with any noise (a round of fewer fills the device less, but spends nothing on
   // pixels with nothing to gain).
   const size_t least = (film.pixels() + kAdaptiveMinShare - 1) / kAdaptiveMinShare;
-  if (taken < least) {
+  if (taken() < least) {
     std::vector<uint32_t> noisy;
     for (size_t p = 0; p < film.pixels(); ++p)
       if (fall[p] > 0.0) noisy.push_back(uint32_t(p));
@@ -110,7 +109,8 @@ std::shared_ptr<const PixelList> adaptivePixels(const Film& film, uint32_t begin
                      [&](uint32_t a, uint32_t b) { return fall[a] != fall[b] ? fall[a] > fall[b] : a < b; });
     for (size_t i = 0; i < more; ++i) chosen[noisy[i]] = 1;
   }
-  if (std::none_of(chosen.begin(), chosen.end(), [](char c) { return c != 0; })) return nullptr;
+  const size_t count = taken();
+  if (count == 0) return nullptr;
   // What a sample takes off, on average over the round, were its samples those pixels' or
   // every pixel's: the round is every pixel's unless choosing gains clearly more. Below
   // kAdaptiveLeastGain it does not pay: the noisiest pixels' samples are dearer (longer
@@ -122,7 +122,6 @@ std::shared_ptr<const PixelList> adaptivePixels(const Film& film, uint32_t begin
     gainAll += gain;
     if (chosen[p]) gainChosen += gain;
   }
-  size_t count = size_t(std::count(chosen.begin(), chosen.end(), char(1)));
   if (gainChosen / double(count) < kAdaptiveLeastGain * gainAll / double(film.pixels())) return nullptr;
   auto pixels = std::make_shared<PixelList>();
   for (size_t p = 0; p < film.pixels(); ++p)

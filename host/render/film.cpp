@@ -22,8 +22,8 @@ void addEach(std::vector<double>& to, const std::vector<double>& from) {
 
 Film::Film(int w, int h, bool surfaceAovs, bool twoReplicates, uint64_t firstPass)
     : width(w), height(h), sum(pixels() * 4, 0.0), sumSq(pixels() * 4, 0.0),
-      aovSum(surfaceAovs ? pixels() * kAovSumsPerPixel : 0, 0.0), oddSum(twoReplicates ? pixels() * kOddSumsPerPixel : 0, 0.0),
-      firstPass_(firstPass) {}
+      aovSum(surfaceAovs ? pixels() * kAovSumsPerPixel : 0, 0.0),
+      oddSum(twoReplicates ? pixels() * kOddSumsPerPixel : 0, 0.0), firstPass_(firstPass) {}
 
 void Film::merge(const Film& other) {
   if (other.width != width || other.height != height || other.aovSum.size() != aovSum.size() ||

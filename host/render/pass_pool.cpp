@@ -14,9 +14,7 @@ namespace {
 double secondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
-}  // namespace
 
-namespace {
 // The passes a render may number: global sample pass * pixels + pixel is 32 bits (an
 // adaptive render's passes cover fewer pixels, so it may have more than spp of them).
 uint32_t passLimit(const RenderSettings& s) {
@@ -36,7 +34,6 @@ PassPool::PassPool(const RenderSettings& s, int workers)
       lastCheckpoint_(std::chrono::steady_clock::now()) {
   // A resumed render goes on from the first pass its film lacks; a chunk starts at its first.
   next_ = nextToMerge_ = uint32_t(film_.nextPass());
-  merged_ = film_.passes();
   mergedSamples_ = film_.samples();
   samplesDone_.assign(size_t(workers), 0);
   round_ = {total_, nullptr, film_.pixels()};
@@ -163,7 +160,6 @@ Film PassPool::finish(bool& complete) {
   for (auto& [pass, samples] : pending_) {
     if (noiseReached_) break;  // beyond the pass that met the target
     film_.addPass(pass, samples, round_.pixels.get());
-    ++merged_;
     mergedSamples_ += double(round_.size);
   }
   pending_.clear();
@@ -177,11 +173,7 @@ Film PassPool::finish(bool& complete) {
 // render resumed from it knows the round whatever it covers.
 void PassPool::openRound(uint32_t begin, std::shared_ptr<const PixelList> pixels) {
   round_ = {adaptiveRoundEnd(begin), pixels, pixels ? pixels->size() : film_.pixels()};
-  if (!pixels && begin >= kAdaptiveFirstRound) {
-    auto every = std::make_shared<PixelList>(film_.pixels());
-    for (size_t p = 0; p < every->size(); ++p) (*every)[p] = uint32_t(p);
-    pixels = std::move(every);
-  }
+  if (!pixels && begin >= kAdaptiveFirstRound) pixels = std::make_shared<const PixelList>(everyPixel(film_.pixels()));
   film_.roundPixels = std::move(pixels);
 }
 
@@ -218,7 +210,6 @@ void PassPool::mergeInOrder() {
     lock.lock();
     spare_.push_back(std::move(samples));
     ++nextToMerge_;
-    ++merged_;
     mergedSamples_ += double(round_.size);
     if (roundEnds) {
       openRound(round_.end, nextPixels);

@@ -67,8 +67,7 @@ class PassPool : public PassSource {
   std::chrono::steady_clock::time_point start_;  // when the first pass was handed out
   bool started_ = false;
   uint32_t next_ = 0, nextToMerge_ = 0;
-  uint64_t merged_ = 0;
-  double mergedSamples_ = 0;
+  double mergedSamples_ = 0;  // in the film: what the progress display counts
   // The passes handed out now cover these pixels, up to pass `end` (every pixel and every
   // pass but in an adaptive render).
   struct Round {

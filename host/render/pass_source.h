@@ -6,12 +6,20 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <numeric>
 #include <vector>
 
 namespace fh {
 
 // The pixels a pass covers, ascending pixel indices; shared by the passes of a round.
 using PixelList = std::vector<uint32_t>;
+
+// The list of every one of `pixels` pixels.
+inline PixelList everyPixel(size_t pixels) {
+  PixelList list(pixels);
+  std::iota(list.begin(), list.end(), 0u);
+  return list;
+}
 
 struct Pass {
   uint32_t index = 0;

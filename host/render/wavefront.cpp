@@ -78,8 +78,9 @@ ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, cons
   return {std::string("path tracer (") + methodName(method) + features.buildOptions() + ", " + strategyName(strategy) +
               (surfaceAovs ? ", aovs" : "") + ")",
           mega ? std::vector<std::string>{stageInfo(Stage::PlanIteration).file, kMegakernel.file} : stageFiles(),
-          traversalOptions + features.buildOptions() + " -DFH_METHOD_" + methodFlag + " -DFH_LANES=" + std::to_string(lanesOf(strategy)) +
-              (mega ? " -DFH_MEGAKERNEL" : "") + (surfaceAovs ? " -DFH_AOVS" : "")};
+          traversalOptions + features.buildOptions() + " -DFH_METHOD_" + methodFlag +
+              " -DFH_LANES=" + std::to_string(lanesOf(strategy)) + (mega ? " -DFH_MEGAKERNEL" : "") +
+              (surfaceAovs ? " -DFH_AOVS" : "")};
 }
 
 Strategy strategyFor(const DeviceInfo& device, Strategy asked) {
@@ -128,8 +129,7 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
     throw Error("--spp " + std::to_string(s.spp) + " at " + std::to_string(s.width) + "x" + std::to_string(s.height) +
                 " is more than 2^32 samples in one render; render fewer");
   passTable_.assign(FH_MAX_PASS_SLOTS, 0);
-  everyPixel_.resize(pixels_);
-  for (uint32_t p = 0; p < pixels_; ++p) everyPixel_[p] = p;
+  everyPixel_ = everyPixel(pixels_);
   passShape_ = {pixels_, 0, 0, uint32_t(fullPasses)};
   counters_.pass_pixels = pixels_;
   counters_.pass_ring = uint32_t(fullPasses);
@@ -191,8 +191,8 @@ void WavefrontPipeline::bindArguments(unsigned parity) {
     ArgumentList(megakernels_[parity])
         << params_ << queues_.counters << parity << queues_.freeSlots << filterTable_ << passTableBuffer_
         << pixelListBuffer_ << sc.bvh.nodes() << sc.bvh.blocks() << sc.bvh.triangles() << sc.triangleMaterial
-        << sc.materials << sc.lightCdf << sc.lightTriangle << sc.lightPdfArea << sc.normals << sc.uvs << sc.texels << sc.textureInfo
-        << sc.environment << passBuffers_ << aovBuffers_ << paths_;
+        << sc.materials << sc.lightCdf << sc.lightTriangle << sc.lightPdfArea << sc.normals << sc.uvs << sc.texels
+        << sc.textureInfo << sc.environment << passBuffers_ << aovBuffers_ << paths_;
     return;
   }
   args(Stage::Generate) << params_ << queues_.counters << queues_.freeSlots << rays << filterTable_

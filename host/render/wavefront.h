@@ -44,10 +44,11 @@ struct SlotQueues {
   cl::Buffer finished, freeSlots, counters;
 };
 
-// The path tracer's program for a scene's features, a method and a strategy (the paths each work-item carries, FH_LANES; for the megakernels, the books and
-// megakernel.cl instead of the stage files); with surfaceAovs, shade records the
-// first-surface layers (FH_AOVS).
-ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, const std::string& traversalOptions, Strategy strategy, bool surfaceAovs = false);
+// The path tracer's program for a scene's features, a method and a strategy (the paths each
+// work-item carries, FH_LANES; for the megakernels, the books and megakernel.cl instead of
+// the stage files); with surfaceAovs, shade records the first-surface layers (FH_AOVS).
+ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, const std::string& traversalOptions,
+                              Strategy strategy, bool surfaceAovs = false);
 
 // The features a render's kernels are compiled with: the scene's (or all of them with
 // --all-features), and the environment map if the render has one.
@@ -134,7 +135,7 @@ class WavefrontPipeline {
   SlotQueues queues_;
   cl::Buffer passBuffers_, filterTable_, passTableBuffer_, pixelListBuffer_;
   bool surfaceAovs_;
-  cl::Buffer aovBuffers_;  // per pass slot and pixel, kernels/aovs.h (a placeholder without AOVs)
+  cl::Buffer aovBuffers_;  // per pass entry, kernels/aovs.h (a placeholder without AOVs)
   // Global pass of each local pass in flight, by local pass % passSlots() (stable storage for writes).
   std::vector<uint32_t> passTable_;
   uint32_t sampleLimit_ = 0;  // local samples that may start (stable storage for writes)
