@@ -2,22 +2,21 @@
 // sample per pixel per pass, so one writer per entry) and free their slots. The host reads
 // a pass back once all its pixels are in and merges passes into the film in pass order,
 // which keeps the image deterministic for a seed whatever order paths finish in. Up to
-// pass_ring passes are in flight, so the wavefront stays full while a pass's last,
-// longest paths finish. FH_LANES paths per work-item (lanes.h).
+// FH_MAX_PASS_SLOTS passes are in flight, so the wavefront stays full while a pass's
+// last, longest paths finish. FH_LANES paths per work-item (lanes.h).
 #include "path_state.h"
 #include "lanes.h"
 
 // Writes the radiance of finished paths p (where `active`) to their entries in the pass
-// buffers (pass_pixels entries per slot), a non-finite value as zero; returns which were
-// finite and sets *pass_slot to their pass slots.
-FH_INLINE lmask record_samples(luint p, lmask active, uint pass_pixels, __global float4* pass_buffer,
-                               luint* pass_slot FH_PATH_PARAMS) {
-  const luint entry = gather_uint(pass_entry, p);
+// buffers, a non-finite value as zero; returns which were finite and sets *pass_slot to
+// their pass slots.
+FH_INLINE lmask record_samples(luint p, lmask active, __global float4* pass_buffer, luint* pass_slot FH_PATH_PARAMS) {
+  const luint code = gather_uint(pass_entry, p), entry = code / FH_MAX_PASS_SLOTS;
   lvec3 value = gather_xyz(radiance, p);
   const lmask finite = isfinite(value.x) && isfinite(value.y) && isfinite(value.z);
   value = v3_select(finite, value, v3_splat(0.0f));
   scatter_xyzw(pass_buffer, entry, value, (lfloat)(1.0f), active);
-  *pass_slot = entry / pass_pixels;
+  *pass_slot = code % FH_MAX_PASS_SLOTS;
   return finite;
 }
 
@@ -34,7 +33,7 @@ __kernel void accumulate(__global const uint* finished_queue, volatile __global 
     const luint i = select((luint)(0), position, active);
     const luint p = gather_uint(finished_queue, i);
     luint slot;
-    const lmask finite = record_samples(p, active, counters->pass_pixels, pass_buffer, &slot FH_PATH_ARGS);
+    const lmask finite = record_samples(p, active, pass_buffer, &slot FH_PATH_ARGS);
     scatter_uint(free_list, counters->free_length + i, p, active);
     FH_FOR_LANES(l) {
       if (!LANE(active, l)) continue;

@@ -1,7 +1,7 @@
 // The first-surface layers a denoiser or compositor wants beside the image (--aovs
 // albedo,normal,depth), recorded by shade in the same render as the radiance, built with
-// FH_AOVS only. Each sample writes its entry in its pass slot (pass_entry: one writer per
-// entry, as for radiance), two float4s:
+// FH_AOVS only. Each sample writes its entry of the pass buffers (pass_entry: one writer
+// per entry, as for radiance), two float4s:
 //   [0] albedo rgb of the first non-specular surface, w: 1 once found, -1 while pending
 //       (only delta bounces so far: mirrors and glass are looked through, as denoisers
 //       expect; a path that ends before finding one keeps the last such surface's values)
@@ -16,9 +16,9 @@
 
 #define FH_AOV_FLOAT4S 2
 
-// The entry of path p's sample in its pass slot.
+// The entry of path p's sample in the AOV buffers.
 FH_INLINE luint aov_entry(luint p, __global const uint* pass_entry) {
-  return FH_AOV_FLOAT4S * gather_uint(pass_entry, p);
+  return FH_AOV_FLOAT4S * (gather_uint(pass_entry, p) / FH_MAX_PASS_SLOTS);
 }
 
 // What a denoiser takes as a surface's albedo: its diffuse and specular reflectance.

@@ -6,30 +6,25 @@
 #include "path_state.h"
 #include "sampler.h"
 
-// The shape of the passes in flight (WavefrontCounters::pass_pixels and after), read once.
-typedef struct {
-  uint pixels, first_sample, first_pass, ring;
-} PassShape;
-#define FH_PASS_SHAPE(counters)                                                                   \
-  ((PassShape){(counters)->pass_pixels, (counters)->round_first_sample, (counters)->round_first_pass, \
-               (counters)->pass_ring})
-
 // Starts device sample j (a device numbers its samples locally) in path slot `slot`. Its
 // passes are granted by the host, which may hand different passes to different devices:
-// from the shape's first sample on, every shape.pixels samples are one local pass, whose
-// global pass is in pass_table (a ring of shape.ring entries, the pass slots: a slot is
-// reused once its pass is returned), and sample i of a pass renders pixel_list[i] into
-// entry i of its slot's pass buffer (pass_entry). Global sample
+// from a shape's first sample on, every shape.pixels samples are one local pass, whose
+// global pass is in pass_table at its pass slot, and sample i of a pass renders the
+// shape's i-th listed pixel into entry j % entries of the pass buffers (pass_entry, with
+// the slot). Samples before newer.first_sample are of the older shape. Global sample
 // k = pass * pixel_count + pixel seeds the random numbers, so a sample is the same
 // whichever device renders it, and the pixel's samples are its passes' points of one
 // sequence whichever passes cover it.
-FH_INLINE void start_sample(RenderParams params, PassShape shape, luint j, luint slot, lmask active,
-                            __global const float* filter_table, __global const uint* pass_table,
+FH_INLINE void start_sample(RenderParams params, PassShape older, PassShape newer, uint entries, luint j, luint slot,
+                            lmask active, __global const float* filter_table, __global const uint* pass_table,
                             __global const uint* pixel_list FH_PATH_PARAMS) {
-  const luint in_round = j - shape.first_sample;
-  const luint pass_slot = (shape.first_pass + in_round / shape.pixels) % shape.ring;
-  const luint index = in_round % shape.pixels;
-  const luint pixel = gather_uint(pixel_list, index);
+  const lmask is_newer = j >= newer.first_sample;
+  const luint pixels = select((luint)(older.pixels), (luint)(newer.pixels), is_newer);
+  const luint in_shape = j - select((luint)(older.first_sample), (luint)(newer.first_sample), is_newer);
+  const luint local_pass = select((luint)(older.first_pass), (luint)(newer.first_pass), is_newer) + in_shape / pixels;
+  const luint pass_slot = local_pass % FH_MAX_PASS_SLOTS;
+  const luint index = in_shape % pixels;
+  const luint pixel = gather_uint(pixel_list, select((luint)(older.list), (luint)(newer.list), is_newer) + index);
   const luint pass = gather_uint(pass_table, pass_slot);
   const luint k = pass * params.pixel_count + pixel;
   const PixelSampler sampler = pixel_sampler(params.seed, k, params.pixel_count, params.replicates);
@@ -43,7 +38,7 @@ FH_INLINE void start_sample(RenderParams params, PassShape shape, luint j, luint
   scatter_float(ray_pdf, slot, (lfloat)(0.0f), active);
   scatter_xyzw(radiance, slot, v3_splat(0.0f), (lfloat)(0.0f), active);
   scatter_uint(sample_id, slot, k, active);
-  scatter_uint(pass_entry, slot, pass_slot * shape.pixels + index, active);
+  scatter_uint(pass_entry, slot, (j % entries) * FH_MAX_PASS_SLOTS + pass_slot, active);
   scatter_uint(depth, slot, (luint)(0), active);
 }
 
@@ -58,8 +53,8 @@ __kernel void generate(RenderParams params, __global const WavefrontCounters* co
   if (!lanes_any(active)) return;
   const luint i = select((luint)(0), position, active);  // idle lanes compute sample 0 and write nothing
   const luint slot = gather_uint(free_list, counters->new_free_top - 1 - i);
-  start_sample(params, FH_PASS_SHAPE(counters), counters->new_first + i, slot, active, filter_table, pass_table,
-               pixel_list FH_PATH_ARGS);
+  start_sample(params, counters->shapes[0], counters->shapes[1], counters->pass_entries, counters->new_first + i, slot,
+               active, filter_table, pass_table, pixel_list FH_PATH_ARGS);
   scatter_uint(ray_queue, counters->new_queue_base + i, slot, active);
 }
 #endif

@@ -34,7 +34,8 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
   // Lane g owns free slot g (all are free between launches) and takes samples g, g + slots,
   // g + 2 slots, ... of the new_count planned.
   const uint slots = counters->new_free_top, count = counters->new_count;
-  const PassShape shape = FH_PASS_SHAPE(counters);
+  const PassShape older = counters->shapes[0], newer = counters->shapes[1];
+  const uint entries = counters->pass_entries;
   const luint g = lane_positions(get_global_id(0) * FH_LANES);
   const lmask owns_slot = g < slots && g < count;
   if (lanes_any(owns_slot)) {
@@ -45,8 +46,8 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
     for (;;) {
       const lmask starts = owns_slot && !alive && next < count;
       if (lanes_any(starts)) {
-        start_sample(params, shape, counters->new_first + next, p, starts, filter_table, pass_table, pixel_list
-                     FH_PATH_ARGS);
+        start_sample(params, older, newer, entries, counters->new_first + next, p, starts, filter_table, pass_table,
+                     pixel_list FH_PATH_ARGS);
         next = select(next, next + slots, starts);
         alive = alive || starts;
       }
@@ -63,7 +64,7 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
       bounce_rays += lanes_count(o.continues);
       if (lanes_any(o.finished)) {
         luint slot;
-        const lmask finite = record_samples(p, o.finished, shape.pixels, pass_buffer, &slot FH_PATH_ARGS);
+        const lmask finite = record_samples(p, o.finished, pass_buffer, &slot FH_PATH_ARGS);
         FH_FOR_LANES(l) {
           if (LANE(o.finished, l)) atomic_inc(&finished_in_slot[LANE(slot, l)]);
         }

@@ -89,7 +89,18 @@ typedef struct {
 // keeps its own books (iteration.cl), so the host can queue many iterations without
 // waiting for any: it reads this back only now and then. 64-bit totals are (low, high)
 // pairs, as OpenCL 1.2 has no 64-bit atomics to rely on.
-#define FH_MAX_PASS_SLOTS 32  // passes in flight at most (WavefrontCounters::pass_ring <= this)
+#define FH_MAX_PASS_SLOTS 64  // passes in flight at most: local pass p is in pass slot p % this
+
+// The shape of a run of passes: each covers `pixels` pixels, those listed from `list` on in
+// the pixel list (every pixel, or an adaptive round's, render/adaptive.h); its first pass is
+// local pass `first_pass` and starts at local sample `first_sample`.
+typedef struct {
+  uint pixels;
+  uint first_sample;
+  uint first_pass;
+  uint list;
+} PassShape;
+
 typedef struct {
   uint ray_length[2];    // the two ray queues; the iteration's parity says which is current
   uint shadow_length;    // light-sample requests this iteration
@@ -106,15 +117,12 @@ typedef struct {
   uint shadow_rays[2];   // light-sample requests (shadow rays at most)
   uint queued_rays[2];   // rays in the current queue, summed over iterations (occupancy)
   uint iterations;
-  // The passes in flight share one shape: each covers pass_pixels pixels, those listed
-  // first in the pixel list (every pixel, or an adaptive round's, render/adaptive.h); the
-  // shape's first pass starts at local sample round_first_sample and is local pass
-  // round_first_pass; local pass p uses pass slot p % pass_ring, whose pass buffer holds
-  // pass_pixels entries, one per pixel listed. The host sets them when no pass is in flight.
-  uint pass_pixels;
-  uint round_first_sample;
-  uint round_first_pass;
-  uint pass_ring;
+  // The passes in flight are of two shapes at most: shapes[1] from its first sample on,
+  // shapes[0] before it (the host sets a new shape once every sample of shapes[0] has
+  // started). Local sample j writes entry j % pass_entries of the pass buffers, so a pass's
+  // entries follow its predecessor's whatever their shapes.
+  PassShape shapes[2];
+  uint pass_entries;
   uint pass_done[FH_MAX_PASS_SLOTS];  // per pass slot: paths finished in the pass it holds
 } WavefrontCounters;
 

@@ -55,7 +55,13 @@ FH_LAYOUT(RenderParams, env_height, 132);
 FH_LAYOUT(RenderParams, env_u_shift, 136);
 FH_LAYOUT(RenderParams, env_pick, 140);
 
-static_assert(sizeof(WavefrontCounters) == 220, "WavefrontCounters");
+static_assert(sizeof(PassShape) == 16, "PassShape");
+FH_LAYOUT(PassShape, pixels, 0);
+FH_LAYOUT(PassShape, first_sample, 4);
+FH_LAYOUT(PassShape, first_pass, 8);
+FH_LAYOUT(PassShape, list, 12);
+
+static_assert(sizeof(WavefrontCounters) == 368, "WavefrontCounters");
 FH_LAYOUT(WavefrontCounters, ray_length, 0);
 FH_LAYOUT(WavefrontCounters, shadow_length, 8);
 FH_LAYOUT(WavefrontCounters, finished_length, 12);
@@ -71,11 +77,9 @@ FH_LAYOUT(WavefrontCounters, bounce_rays, 48);
 FH_LAYOUT(WavefrontCounters, shadow_rays, 56);
 FH_LAYOUT(WavefrontCounters, queued_rays, 64);
 FH_LAYOUT(WavefrontCounters, iterations, 72);
-FH_LAYOUT(WavefrontCounters, pass_pixels, 76);
-FH_LAYOUT(WavefrontCounters, round_first_sample, 80);
-FH_LAYOUT(WavefrontCounters, round_first_pass, 84);
-FH_LAYOUT(WavefrontCounters, pass_ring, 88);
-FH_LAYOUT(WavefrontCounters, pass_done, 92);
+FH_LAYOUT(WavefrontCounters, shapes, 76);
+FH_LAYOUT(WavefrontCounters, pass_entries, 108);
+FH_LAYOUT(WavefrontCounters, pass_done, 112);
 
 #undef FH_LAYOUT
 

@@ -13,7 +13,7 @@ constexpr int kIterationsPerBatch = 8;
 
 void DeviceWorker::run(const RenderSettings& settings) {
   takePasses();
-  while (returned_ < granted_ && !settings.stopRequested()) {
+  while ((returned_ < granted_ || held_) && !settings.stopRequested()) {
     for (int i = 0; i < kIterationsPerBatch; ++i) pipeline_.enqueueIteration();
     pipeline_.readCounters();
     returnCompletePasses();
@@ -21,19 +21,21 @@ void DeviceWorker::run(const RenderSettings& settings) {
   }
 }
 
-// New passes while fewer than passSlots() are unfinished. A pass of another shape (an
-// adaptive round's pixels) comes only when none is in flight: the pipeline switches to it.
+// New passes while they fit in the pipeline. One that does not fit yet (its samples would
+// overrun the pass buffers, or its shape waits for the older shape's samples to start) is
+// held for the next batch.
 void DeviceWorker::takePasses() {
   const uint64_t before = granted_;
-  Pass pass;
-  while (granted_ - returned_ < pipeline_.passSlots() && source_.take(index_, pass)) {
-    if (pass.pixels != pipeline_.passPixels()) {
-      if (granted_ != returned_) throw Error("internal: a pass of another shape while passes are in flight");
-      pipeline_.setPassPixels(pass.pixels, granted_);
+  for (;;) {
+    if (!held_) {
+      if (granted_ - returned_ >= FH_MAX_PASS_SLOTS || !source_.take(index_, heldPass_)) break;
+      held_ = true;
     }
-    pipeline_.grantPass(granted_++, pass.index);
+    if (!pipeline_.fits(heldPass_.pixels, granted_, returned_)) break;
+    pipeline_.grantPass(granted_++, heldPass_.index, std::move(heldPass_.pixels));
+    held_ = false;
   }
-  if (granted_ != before) pipeline_.startGrantedPasses(granted_);
+  if (granted_ != before) pipeline_.startGrantedPasses();
 }
 
 // Every complete pass, in local order (a pass's slot is reused only after it is returned).

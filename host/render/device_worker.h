@@ -1,5 +1,5 @@
-// One device's part in a render: it takes passes from the source while it has pass slots
-// free, queues iterations in batches, and hands each pass back as soon as it is complete.
+// One device's part in a render: it takes passes from the source while they fit in its
+// pipeline, queues iterations in batches, and hands each pass back as soon as it is complete.
 #pragma once
 #include "render/pass_source.h"
 #include "render/wavefront.h"
@@ -28,6 +28,8 @@ class DeviceWorker {
   PassSource& source_;
   long failAfter_;
   uint64_t granted_ = 0, returned_ = 0;  // local passes
+  Pass heldPass_;       // taken from the source, not yet granted: it did not fit
+  bool held_ = false;
   std::vector<float> samples_;
 };
 

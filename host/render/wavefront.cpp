@@ -122,17 +122,23 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
   // longest paths finish: each costs a frame of pass buffers, so only as many as the
   // wavefront needs. Passes of fewer pixels (an adaptive round's) fit more times.
   const size_t fullPasses = std::min<size_t>(kMostFullPasses, 2 + (2 * wavefront_ + pixels_ - 1) / pixels_);
-  passEntries_ = fullPasses * pixels_;
+  // A path's pass_entry holds its entry times FH_MAX_PASS_SLOTS in 32 bits.
+  const size_t mostEntries = (size_t(1) << 32) / FH_MAX_PASS_SLOTS;
+  if (pixels_ > mostEntries)
+    throw Error(std::to_string(s.width) + "x" + std::to_string(s.height) + " is more than " +
+                std::to_string(mostEntries) + " pixels; render a smaller image");
+  passEntries_ = std::min(fullPasses * pixels_, mostEntries / pixels_ * pixels_);
   // Global sample numbers are 32 bits: at most spp passes (a time budget stops earlier; an
   // adaptive render's passes cover fewer pixels, and its pool counts them).
   if (uint64_t(std::max(1, s.spp)) * pixels_ >= (uint64_t(1) << 32))
     throw Error("--spp " + std::to_string(s.spp) + " at " + std::to_string(s.width) + "x" + std::to_string(s.height) +
                 " is more than 2^32 samples in one render; render fewer");
-  passTable_.assign(FH_MAX_PASS_SLOTS, 0);
+  passes_.assign(FH_MAX_PASS_SLOTS, {});
   everyPixel_ = everyPixel(pixels_);
-  passShape_ = {pixels_, 0, 0, uint32_t(fullPasses)};
-  counters_.pass_pixels = pixels_;
-  counters_.pass_ring = uint32_t(fullPasses);
+  lists_ = {everyPixel_, {}};
+  shapes_[0] = shapes_[1] = {pixels_, 0, 0, 0};  // every pixel, listed in the first half
+  std::copy(shapes_.begin(), shapes_.end(), counters_.shapes);
+  counters_.pass_entries = uint32_t(passEntries_);
 
   const cl::Program program = buildProgram(
       dc.context, dc.info.device, pathTracerProgram(scene_.features, s.method, scene_.bvh.traversalOptions(),
@@ -172,8 +178,10 @@ void WavefrontPipeline::allocateBuffers(const std::vector<float>& filterTable) {
   aovBuffers_ = buffer(surfaceAovs_ ? passEntries_ * kAovFloatsPerPixel * 4 : 16, "AOV buffers");
   filterTable_ = allocateBuffer(dc_.context, dc_.info.device, CL_MEM_READ_ONLY, filterTable.size() * 4,
                                 "filter table", filterTable.data());
-  passTableBuffer_ = buffer(passTable_.size() * 4, "pass table");
-  pixelListBuffer_ = buffer(size_t(pixels_) * 4, "pixel list", everyPixel_.data());
+  passTableBuffer_ = buffer(FH_MAX_PASS_SLOTS * 4, "pass table");
+  std::vector<uint32_t> lists(2 * size_t(pixels_));  // each shape's list in a half of its own
+  std::copy(everyPixel_.begin(), everyPixel_.end(), lists.begin());
+  pixelListBuffer_ = buffer(lists.size() * 4, "pixel lists", lists.data());
 }
 
 // Every argument of every stage, for one parity. The argument lists follow the kernels'
@@ -242,28 +250,47 @@ void WavefrontPipeline::writeCounter(size_t offset, const uint32_t& value) {
   FH_CL(dc_.queue.enqueueWriteBuffer(queues_.counters, CL_FALSE, offset, 4, &value));
 }
 
-void WavefrontPipeline::grantPass(uint64_t local, uint32_t global) {
-  const size_t entry = size_t(local % passSlots());  // free: its last pass was returned
-  passTable_[entry] = global;                       // stable storage: the write is asynchronous
-  FH_CL(dc_.queue.enqueueWriteBuffer(passTableBuffer_, CL_FALSE, entry * 4, 4, &passTable_[entry]));
+bool WavefrontPipeline::fits(const std::shared_ptr<const PixelList>& pixels, uint64_t granted,
+                             uint64_t returned) const {
+  if (granted - returned >= FH_MAX_PASS_SLOTS) return false;
+  const uint32_t size = pixels ? uint32_t(pixels->size()) : pixels_;
+  // The pass buffers are a ring of entries in local sample order, from the oldest pass's.
+  const uint32_t oldest = granted == returned ? grantedSamples_ : passes_[returned % FH_MAX_PASS_SLOTS].firstSample;
+  if (size_t(grantedSamples_ - oldest) + size > passEntries_) return false;
+  // A new shape takes the pixel list of the older one: all its samples must have started
+  // (as of the last readCounters).
+  return pixels == shapePixels_[1] || counters_.next_sample >= shapes_[1].first_sample;
 }
 
-void WavefrontPipeline::setPassPixels(std::shared_ptr<const PixelList> pixels, uint64_t granted) {
-  passPixels_ = std::move(pixels);
-  const std::vector<uint32_t>& list = passPixels_ ? *passPixels_ : everyPixel_;
+void WavefrontPipeline::grantPass(uint64_t local, uint32_t global, std::shared_ptr<const PixelList> pixels) {
+  if (pixels != shapePixels_[1]) newShape(std::move(pixels), local);
+  const size_t slot = size_t(local % FH_MAX_PASS_SLOTS);  // free: its last pass was returned
+  passes_[slot] = {global, grantedSamples_, shapes_[1].pixels};
+  grantedSamples_ += shapes_[1].pixels;
+  FH_CL(dc_.queue.enqueueWriteBuffer(passTableBuffer_, CL_FALSE, slot * 4, 4, &passes_[slot].global));
+}
+
+// The newer shape becomes the older, and local pass `local` on is of the new one, whose
+// pixel list takes the half of the pixel-list buffer the older's older had.
+void WavefrontPipeline::newShape(std::shared_ptr<const PixelList> pixels, uint64_t local) {
+  const std::vector<uint32_t>& list = pixels ? *pixels : everyPixel_;
   if (list.empty() || list.size() > pixels_) throw Error("internal: a pass of no pixels, or of too many");
-  // Nothing is in flight: every sample granted so far has started (sampleLimit_).
-  const size_t ring = std::min<size_t>(FH_MAX_PASS_SLOTS, passEntries_ / list.size());
-  passShape_ = {uint32_t(list.size()), sampleLimit_, uint32_t(granted), uint32_t(ring)};
-  FH_CL(dc_.queue.enqueueWriteBuffer(pixelListBuffer_, CL_FALSE, 0, list.size() * 4, list.data()));
-  FH_CL(dc_.queue.enqueueWriteBuffer(queues_.counters, CL_FALSE, offsetof(gpu::WavefrontCounters, pass_pixels),
-                                     sizeof passShape_, passShape_.data()));
+  const size_t half = shapes_[1].list == 0 ? 1 : 0;
+  lists_[half] = list;  // stable storage for the write
+  shapes_[0] = shapes_[1];
+  shapes_[1] = {uint32_t(list.size()), grantedSamples_, uint32_t(local), uint32_t(half * pixels_)};
+  shapePixels_[0] = std::move(shapePixels_[1]);
+  shapePixels_[1] = std::move(pixels);
+  FH_CL(dc_.queue.enqueueWriteBuffer(pixelListBuffer_, CL_FALSE, half * pixels_ * 4, list.size() * 4,
+                                     lists_[half].data()));
+  FH_CL(dc_.queue.enqueueWriteBuffer(queues_.counters, CL_FALSE, offsetof(gpu::WavefrontCounters, shapes),
+                                     sizeof shapes_, shapes_.data()));
 }
 
-void WavefrontPipeline::startGrantedPasses(uint64_t granted) {
+void WavefrontPipeline::startGrantedPasses() {
   // sampleLimit_ is the source of an asynchronous write: it is set once per batch, after the
   // previous batch's write has completed (readCounters waits for the queue).
-  sampleLimit_ = passShape_[1] + uint32_t(granted - passShape_[2]) * passShape_[0];
+  sampleLimit_ = grantedSamples_;
   writeCounter(offsetof(gpu::WavefrontCounters, sample_limit), sampleLimit_);
 }
 
@@ -280,17 +307,25 @@ const gpu::WavefrontCounters& WavefrontPipeline::readCounters() {
 }
 
 bool WavefrontPipeline::passComplete(uint64_t local) const {
-  return counters_.pass_done[local % passSlots()] == passShape_[0];
+  const PassInFlight& pass = passes_[local % FH_MAX_PASS_SLOTS];
+  return counters_.pass_done[local % FH_MAX_PASS_SLOTS] == pass.pixels;
 }
 
 void WavefrontPipeline::takePass(uint64_t local, std::vector<float>& samples) {
-  const size_t slot = size_t(local % passSlots()), count = passShape_[0];
+  const size_t slot = size_t(local % FH_MAX_PASS_SLOTS), count = passes_[slot].pixels;
   const size_t aovFloats = surfaceAovs_ ? kAovFloatsPerPixel : 0;
   samples.resize(count * (4 + aovFloats));
-  if (aovFloats)
-    FH_CL(dc_.queue.enqueueReadBuffer(aovBuffers_, CL_FALSE, slot * count * aovFloats * 4, count * aovFloats * 4,
-                                      samples.data() + count * 4));
-  FH_CL(dc_.queue.enqueueReadBuffer(passBuffers_, CL_TRUE, slot * count * 16, count * 16, samples.data()));
+  // Its entries, from its first sample's on, in two runs where the ring wraps.
+  const size_t first = passes_[slot].firstSample % passEntries_, before = std::min(count, passEntries_ - first);
+  const std::array<std::array<size_t, 3>, 2> runs{{{first, 0, before}, {0, before, count - before}}};
+  for (const auto& [entry, index, length] : runs) {
+    if (length == 0) continue;
+    if (aovFloats)
+      FH_CL(dc_.queue.enqueueReadBuffer(aovBuffers_, CL_FALSE, entry * aovFloats * 4, length * aovFloats * 4,
+                                        samples.data() + (count * 4 + index * aovFloats)));
+    FH_CL(dc_.queue.enqueueReadBuffer(passBuffers_, CL_FALSE, entry * 16, length * 16, samples.data() + index * 4));
+  }
+  FH_CL(dc_.queue.finish());
   // Safe to reset: the next pass using this slot has not been granted yet.
   static const uint32_t zero = 0;
   writeCounter(offsetof(gpu::WavefrontCounters, pass_done) + slot * 4, zero);

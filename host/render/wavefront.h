@@ -75,17 +75,15 @@ class WavefrontPipeline {
   void enqueueIteration();
 
   // Passes are numbered locally (0, 1, ... on this device) and mapped to global passes,
-  // which seed the samples. At most passSlots() granted passes may be unfinished: as many
-  // as the pass buffers hold passes of the current shape.
-  unsigned passSlots() const { return passShape_[3]; }
-  void grantPass(uint64_t local, uint32_t global);
-  // The pixels the passes cover (null: every pixel), from local pass `granted` on; set only
-  // when no granted pass is unfinished.
-  void setPassPixels(std::shared_ptr<const PixelList> pixels, uint64_t granted);
-  const std::shared_ptr<const PixelList>& passPixels() const { return passPixels_; }
-  // Lets local passes 0 .. granted-1 start; once per batch, after its grants.
-  void startGrantedPasses(uint64_t granted);
-  uint32_t globalPass(uint64_t local) const { return passTable_[local % passSlots()]; }
+  // which seed the samples. A pass covers the pixels listed (null: every pixel). Passes
+  // are granted while they fit: FH_MAX_PASS_SLOTS unfinished at most, their samples within
+  // the pass buffers, and of two shapes at most: a pass of a new shape waits until every
+  // sample of the older one in flight has started.
+  bool fits(const std::shared_ptr<const PixelList>& pixels, uint64_t granted, uint64_t returned) const;
+  void grantPass(uint64_t local, uint32_t global, std::shared_ptr<const PixelList> pixels);
+  // Lets the passes granted so far start; once per batch, after its grants.
+  void startGrantedPasses();
+  uint32_t globalPass(uint64_t local) const { return passes_[local % FH_MAX_PASS_SLOTS].global; }
 
   // Waits for the queued iterations and reads the books back.
   const gpu::WavefrontCounters& readCounters();
@@ -120,6 +118,7 @@ class WavefrontPipeline {
   void bindArguments(unsigned parity);
   bool launches(Stage s) const;  // whether this strategy launches the stage's own kernel
   void writeCounter(size_t offset, const uint32_t& value);
+  void newShape(std::shared_ptr<const PixelList> pixels, uint64_t local);
 
   DeviceContext& dc_;
   Method method_;
@@ -136,15 +135,21 @@ class WavefrontPipeline {
   cl::Buffer passBuffers_, filterTable_, passTableBuffer_, pixelListBuffer_;
   bool surfaceAovs_;
   cl::Buffer aovBuffers_;  // per pass entry, kernels/aovs.h (a placeholder without AOVs)
-  // Global pass of each local pass in flight, by local pass % passSlots() (stable storage for writes).
-  std::vector<uint32_t> passTable_;
-  uint32_t sampleLimit_ = 0;  // local samples that may start (stable storage for writes)
-  // The passes' shape: the pixels they cover (null: all, listed in everyPixel_), and
-  // WavefrontCounters' pass_pixels, round_first_sample, round_first_pass, pass_ring
-  // (stable storage for writes).
-  std::shared_ptr<const PixelList> passPixels_;
+  // Each local pass in flight, by local pass % FH_MAX_PASS_SLOTS: its global pass (stable
+  // storage for writes), first local sample and pixel count.
+  struct PassInFlight {
+    uint32_t global = 0, firstSample = 0, pixels = 0;
+  };
+  std::vector<PassInFlight> passes_;
+  uint32_t grantedSamples_ = 0;  // local samples of the passes granted so far
+  uint32_t sampleLimit_ = 0;     // what the device may start: stable storage for writes
+  // The two shapes of WavefrontCounters (stable storage for writes) and the pixel lists
+  // they cover (null: every pixel, listed in everyPixel_); a shape's list is in the half
+  // of the pixel-list buffer at its `list`.
+  std::array<gpu::PassShape, 2> shapes_{};
+  std::array<std::shared_ptr<const PixelList>, 2> shapePixels_;
+  std::array<std::vector<uint32_t>, 2> lists_;  // each half's list (stable storage for writes)
   std::vector<uint32_t> everyPixel_;
-  std::array<uint32_t, 4> passShape_{};
   gpu::WavefrontCounters counters_{};
   // Every stage's kernel twice, bound once for each parity: an iteration sets nothing.
   std::array<std::array<cl::Kernel, kStages.size()>, 2> kernels_;
