@@ -52,9 +52,13 @@ Film filmOf(int width, int height, uint32_t passes, const std::function<std::pai
   return film;
 }
 
-TEST(AdaptivePixels, TheFirstRoundCoversEveryPixel) {
-  const Film film = filmOf(8, 8, 0, [](int, int) { return std::make_pair(1.f, 0.f); });
-  EXPECT_EQ(adaptivePixels(film, 0), nullptr);
+// A film of fewer than kAdaptiveFirstRound passes is too little to choose from: every
+// pixel, however noisy.
+TEST(AdaptivePixels, AFilmOfLessThanTheFirstRoundChoosesEveryPixel) {
+  for (uint32_t passes : {0u, kAdaptiveFirstRound - 1}) {
+    const Film film = filmOf(64, 16, passes, [&](int x, int) { return std::make_pair(1.f, x < 8 ? 0.5f : 0.f); });
+    EXPECT_EQ(adaptivePixels(film, kAdaptiveFirstRound, nullptr, kAdaptiveFirstRound), nullptr) << passes;
+  }
 }
 
 // Eight noisy columns of 64, the rest exact: a round takes them and the two columns beside
@@ -62,7 +66,7 @@ TEST(AdaptivePixels, TheFirstRoundCoversEveryPixel) {
 TEST(AdaptivePixels, ARoundTakesTheNoisyPixelsAndTheirNeighbours) {
   const int w = 64, h = 16;
   const Film film = filmOf(w, h, 16, [&](int x, int) { return std::make_pair(1.f, x < 8 ? 0.5f : 0.f); });
-  const auto pixels = adaptivePixels(film, 16);
+  const auto pixels = adaptivePixels(film, 32, nullptr, 16);
   ASSERT_NE(pixels, nullptr);
   EXPECT_TRUE(std::is_sorted(pixels->begin(), pixels->end()));
   std::vector<char> chosen(film.pixels(), 0);
@@ -71,11 +75,28 @@ TEST(AdaptivePixels, ARoundTakesTheNoisyPixelsAndTheirNeighbours) {
     for (int x = 0; x < w; ++x) EXPECT_EQ(bool(chosen[size_t(y * w + x)]), x < 10) << x << "," << y;
 }
 
+// The round before is counted as if in. Columns with 16 times the others' variance are
+// chosen; were the round before to bring them to four times the others' samples, their
+// error would fall as fast as the others' and the round would cover every pixel.
+TEST(AdaptivePixels, TheSamplesOfTheRoundBeforeCount) {
+  const int w = 64, h = 16;
+  const Film film = filmOf(w, h, 16, [&](int x, int) { return std::make_pair(1.f, x < 8 ? 0.5f : 0.125f); });
+  auto noisy = std::make_shared<PixelList>();
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < 8; ++x) noisy->push_back(uint32_t(y * w + x));
+  const auto pixels = adaptivePixels(film, 32, noisy.get(), 0);
+  ASSERT_NE(pixels, nullptr);
+  for (int y = 0; y < h; ++y)
+    for (int x : {0, 7, 16, 63})
+      EXPECT_EQ(std::binary_search(pixels->begin(), pixels->end(), uint32_t(y * w + x)), x < 8) << x << "," << y;
+  EXPECT_EQ(adaptivePixels(film, 64, noisy.get(), 48), nullptr);
+}
+
 // Noise everywhere alike: choosing would not pay, and the round covers every pixel.
 TEST(AdaptivePixels, EvenNoiseKeepsEveryPixel) {
   const Film film =
       filmOf(32, 32, 16, [](int x, int y) { return std::make_pair(1.f, 0.3f + 0.01f * float((x + y) % 3)); });
-  EXPECT_EQ(adaptivePixels(film, 16), nullptr);
+  EXPECT_EQ(adaptivePixels(film, 32, nullptr, 16), nullptr);
 }
 
 // Noise in a few pixels only: the round still covers one pixel in kAdaptiveMinShare, the
@@ -85,14 +106,14 @@ TEST(AdaptivePixels, ARoundCoversAtLeastItsShareOfThePixels) {
   const Film film = filmOf(w, h, 16, [](int x, int y) {
     return std::make_pair(1.f, x == 10 && y == 10 ? 1.f : x < 32 ? 0.001f * float(y + 1) : 0.f);
   });
-  const auto pixels = adaptivePixels(film, 16);
+  const auto pixels = adaptivePixels(film, 32, nullptr, 16);
   ASSERT_NE(pixels, nullptr);
   EXPECT_EQ(pixels->size(), size_t(w * h) / kAdaptiveMinShare);
   EXPECT_TRUE(std::binary_search(pixels->begin(), pixels->end(), uint32_t(10 * w + 10)));
   // After the firefly's neighbourhood, the noisiest rows of the left half: the bottom ones.
   EXPECT_TRUE(std::binary_search(pixels->begin(), pixels->end(), uint32_t(63 * w + 0)));
   EXPECT_FALSE(std::binary_search(pixels->begin(), pixels->end(), uint32_t(20 * w + 0)));
-  EXPECT_EQ(*adaptivePixels(film, 16), *pixels);  // the same film, the same round
+  EXPECT_EQ(*adaptivePixels(film, 32, nullptr, 16), *pixels);  // the same film, the same round
 }
 
 // A pixel with no noise at all still gets samples once it has fewer than one in
@@ -106,7 +127,7 @@ TEST(AdaptivePixels, NoPixelFallsTooFarBehind) {
     samples[0] = samples[1] = samples[2] = pass % 2 ? 2.f : 0.f;
     film.addPass(pass, samples);
   }
-  auto pixels = adaptivePixels(film, 16 * kAdaptiveMaxSpread);
+  auto pixels = adaptivePixels(film, 16 * kAdaptiveMaxSpread, nullptr, 0);
   ASSERT_NE(pixels, nullptr);
   // 16 of 256 samples: not yet behind. The round is pixel 0's neighbourhood alone (fewer
   // than kAdaptiveMinShare: no pixel without noise is taken to fill it).
@@ -115,7 +136,10 @@ TEST(AdaptivePixels, NoPixelFallsTooFarBehind) {
   EXPECT_FALSE(std::binary_search(pixels->begin(), pixels->end(), uint32_t(film.pixels() - 1)));
   samples[0] = samples[1] = samples[2] = 1.f;
   film.addPass(16 * kAdaptiveMaxSpread, samples);
-  EXPECT_EQ(adaptivePixels(film, 16 * kAdaptiveMaxSpread + 1), nullptr) << "16 of 257 samples: all are behind";
+  EXPECT_EQ(adaptivePixels(film, 16 * kAdaptiveMaxSpread + 1, nullptr, 0), nullptr) << "16 of 257 samples: all are behind";
+  // The same where the round before is to bring pixel 0 to 257 samples.
+  pixels = adaptivePixels(film, 16 * kAdaptiveMaxSpread, std::make_shared<PixelList>(PixelList{0}).get(), 1);
+  EXPECT_EQ(pixels, nullptr);
 }
 
 // Each pixel's noise estimate counts its own even and odd samples: pixel 1, in passes 0-2
@@ -136,16 +160,19 @@ TEST(AdaptiveFilm, TheNoiseEstimateCountsEachPixelsOwnSamples) {
   EXPECT_NEAR(film.estimatedRelMse(), (pixel0 + pixel1) / 2, 1e-6);
 }
 
-// A film saved mid-round keeps the round's pixels, and a file whose list is not ascending
-// pixel indices is refused.
+// A film saved mid-round keeps the pixels of its round and of the next, and a file whose
+// list is not ascending pixel indices is refused.
 TEST(AdaptiveFilm, TheRoundsPixelsGoInTheFile) {
   const std::string dir = test::tempDir("adaptive-film");
   Film film = filmOf(4, 4, 16, [](int x, int) { return std::make_pair(1.f, 0.1f * float(x)); });
   film.roundPixels = std::make_shared<PixelList>(PixelList{1, 2, 5, 9});
+  film.nextRoundPixels = std::make_shared<PixelList>(PixelList{0, 3, 15});
   saveFilm(dir + "/f.film", film, "abc", "--film");
   const SavedFilm back = readFilm(dir + "/f.film", "--film");
   ASSERT_NE(back.film.roundPixels, nullptr);
+  ASSERT_NE(back.film.nextRoundPixels, nullptr);
   EXPECT_EQ(*back.film.roundPixels, *film.roundPixels);
+  EXPECT_EQ(*back.film.nextRoundPixels, *film.nextRoundPixels);
   EXPECT_EQ(back.film.sum, film.sum);
   film.roundPixels = std::make_shared<PixelList>(PixelList{2, 1});
   saveFilm(dir + "/g.film", film, "abc", "--film");
@@ -192,7 +219,7 @@ TEST(AdaptiveCli, SpendsTheBudgetUnevenly) {
   for (float n : spp) total += n;
   EXPECT_LE(total, 48.0 * 32 * 32);
   EXPECT_GT(total, 40.0 * 32 * 32) << "most of the budget is spent";
-  EXPECT_EQ(*std::min_element(spp.begin(), spp.end()), 16.f);
+  EXPECT_EQ(*std::min_element(spp.begin(), spp.end()), float(kAdaptiveFirstRound)) << "the first round";
   EXPECT_GT(*std::max_element(spp.begin(), spp.end()), 64.f);
   EXPECT_NE(r.output.find(" spp on "), std::string::npos) << r.output;
 }
@@ -218,7 +245,7 @@ TEST(AdaptiveCli, AResumedRenderFinishesItsRound) {
   const std::string dir = test::tempDir("adaptive-resume");
   ASSERT_EQ(test::runFredholm(kAdaptive + " -o " + dir + "/straight.exr").exitCode, 0);
   const Image straight = readImage(dir + "/straight.exr");
-  for (const char* passes : {"10", "16", "21", "70"}) {
+  for (const char* passes : {"10", "16", "21", "32", "70"}) {
     const std::string ckpt = dir + "/c" + passes + ".fhc", out = dir + "/r" + passes + ".exr";
     const auto killed = test::runFredholm(kAdaptive + " --checkpoint " + ckpt + " --checkpoint-every 0 -o " + out,
                                           std::string("FREDHOLM_KILL_AFTER_PASSES=") + passes);

@@ -84,7 +84,7 @@ TEST(Checkpoint, OtherSettingsOrADamagedFileAreRefused) {
   std::string header;
   std::getline(std::ifstream(ckpt), header);
   const std::string fingerprint = header.substr(header.find(' ') + 1, 16);
-  test::writeFile(dir + "/huge.fhc", "fredholm-film-3 " + fingerprint + " 16384 16384 1 0 3 0 0 0\n0123");
+  test::writeFile(dir + "/huge.fhc", "fredholm-film-4 " + fingerprint + " 16384 16384 1 0 3 0 0 0 0\n0123");
   const auto huge = test::runFredholm(kRender + " --resume " + dir + "/huge.fhc -o " + dir + "/e.exr");
   EXPECT_EQ(huge.exitCode, 1);
   EXPECT_NE(huge.output.find("cut short"), std::string::npos) << huge.output;

@@ -9,10 +9,11 @@
 namespace fh {
 namespace {
 
-// Per pixel, how fast its error falls per sample: the relative variance of its mean (as
-// relMSE weighs it, image/error_metrics.h) over its sample count. A pixel's variance is
-// sigma^2 / n, so this is sigma^2 / n^2: what the next sample takes off.
-std::vector<double> errorFallPerSample(const Film& film) {
+// Per pixel, how fast its error falls per sample once it has counts[p] samples: the
+// relative variance of its mean (as relMSE weighs it, image/error_metrics.h), at that
+// count, over the count. A pixel's variance is sigma^2 / n, so this is sigma^2 / n^2: what
+// the next sample takes off.
+std::vector<double> errorFallPerSample(const Film& film, const std::vector<double>& counts) {
   std::vector<double> fall(film.pixels(), 0.0);
   for (size_t p = 0; p < film.pixels(); ++p) {
     const double n = film.count(p);
@@ -23,7 +24,7 @@ std::vector<double> errorFallPerSample(const Film& film) {
       const double mean = film.sum[4 * p + c] / n;
       relative += variance[c] / (mean * mean + kRelMseEpsilon);
     }
-    fall[p] = relative / (3.0 * n);
+    fall[p] = relative * n / (3.0 * counts[p] * counts[p]);
   }
   return fall;
 }
@@ -83,18 +84,26 @@ uint32_t adaptiveRoundBegin(uint32_t pass) {
   return begin;
 }
 
-std::shared_ptr<const PixelList> adaptivePixels(const Film& film, uint32_t begin) {
-  if (begin < kAdaptiveFirstRound || film.pixels() == 0) return nullptr;
-  const std::vector<double> fall = smoothed(errorFallPerSample(film), film.width, film.height);
+uint32_t adaptiveChoicePoint(uint32_t begin) {
+  return begin < kAdaptiveFirstRound ? kAdaptiveFirstRound : begin + (adaptiveRoundEnd(begin) - begin) / 2;
+}
+
+std::shared_ptr<const PixelList> adaptivePixels(const Film& film, uint32_t begin, const PixelList* before,
+                                                uint32_t beforeLength) {
+  if (film.passes() < kAdaptiveFirstRound || film.pixels() == 0) return nullptr;
+  std::vector<double> counts(film.pixels());
+  for (size_t p = 0; p < film.pixels(); ++p) counts[p] = film.count(p) + (before ? 0.0 : beforeLength);
+  if (before)
+    for (uint32_t p : *before) counts[p] += beforeLength;
+  const std::vector<double> fall = smoothed(errorFallPerSample(film, counts), film.width, film.height);
   // Doubling a pixel's samples quarters what a sample takes off: pixels within a quarter of
   // the busiest still gain as much after this round as the busiest does now. The busiest
   // are the top thousandth's edge, not the one pixel an outlier may have put on top.
   const double threshold = quantile(fall, 0.999) / 4.0;
-  double most = 0.0;
-  for (size_t p = 0; p < film.pixels(); ++p) most = std::max(most, film.count(p));
+  const double most = *std::max_element(counts.begin(), counts.end());
   std::vector<char> chosen(film.pixels(), 0);
   for (size_t p = 0; p < film.pixels(); ++p)
-    chosen[p] = (fall[p] > 0.0 && fall[p] >= threshold) || film.count(p) * kAdaptiveMaxSpread < most;
+    chosen[p] = (fall[p] > 0.0 && fall[p] >= threshold) || counts[p] * kAdaptiveMaxSpread < most;
   const auto taken = [&] { return size_t(std::count(chosen.begin(), chosen.end(), char(1))); };
   // Too few for a full wavefront: the next most deserving too (ties by pixel index), of
   // those with any noise (a round of fewer fills the device less, but spends nothing on
@@ -118,7 +127,7 @@ std::shared_ptr<const PixelList> adaptivePixels(const Film& film, uint32_t begin
   const double length = double(adaptiveRoundEnd(begin) - begin);
   double gainChosen = 0.0, gainAll = 0.0;
   for (size_t p = 0; p < film.pixels(); ++p) {
-    const double gain = fall[p] * film.count(p) / (film.count(p) + length);
+    const double gain = fall[p] * counts[p] / (counts[p] + length);
     gainAll += gain;
     if (chosen[p]) gainChosen += gain;
   }

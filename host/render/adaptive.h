@@ -11,9 +11,15 @@
 // pass 64, then runs half as long as the passes before them (64:96, 96:128, 128:192,
 // 192:256), then of 64 (a pixel a round takes in gets no more than 64 samples at once).
 // Each is a power of two long and starts at a multiple of its length, so a pixel's samples
-// are whole aligned blocks of its low-discrepancy sequence, each block stratified. A round's
-// pixels are chosen from the film of every earlier pass, merged in pass order, so a seed
-// gives the same rounds and the same image whichever devices render them.
+// are whole aligned blocks of its low-discrepancy sequence, each block stratified.
+//
+// A round's pixels are chosen from the film once it holds the first half of the round
+// before it, counting the samples the rest of that round adds (the second round's, once it
+// holds the whole first round: less would be too little to go by). So a round is known
+// before the one before it ends: devices go from round to round without running dry, and
+// passes of two rounds may be in flight at once; and a pixel whose noise shows (a caustic
+// path found) is taken in at most one and a half rounds later. The film is merged in pass
+// order, so a seed gives the same rounds and the same image whichever devices render them.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -42,14 +48,20 @@ constexpr double kAdaptiveLeastGain = 1.5;
 uint32_t adaptiveRoundEnd(uint32_t begin);
 // The round boundary at or before pass `pass`.
 uint32_t adaptiveRoundBegin(uint32_t pass);
+// The passes the film holds when it chooses the pixels of the round after the one that
+// starts at pass `begin`: up to halfway through that round; the first round's, all of it.
+uint32_t adaptiveChoicePoint(uint32_t begin);
 
-// The pixels the round starting at pass `begin` covers, chosen from `film`, which holds
-// passes 0 .. begin - 1: null (every pixel) for the first round; else the pixels whose
+// The pixels the round starting at pass `begin` covers (null: every pixel), chosen from
+// `film`, which holds the passes up to the round before it's choice point; the rest of that
+// round, `beforeLength` passes, covers `before` (null: every pixel), and is counted as if in.
+// Null where the film holds fewer than kAdaptiveFirstRound passes. Else the pixels whose
 // error falls fastest per sample (relative variance over count, averaged over a 3x3 block,
 // then the largest over 3x3, so a pixel whose samples missed a light its neighbours found
 // is not dropped), down to a quarter of the busiest's: those that, after their samples
 // double, still lose error as fast as the busiest do now. Null again where they would gain
 // less than kAdaptiveLeastGain over a round of every pixel. Ascending pixel indices.
-std::shared_ptr<const PixelList> adaptivePixels(const Film& film, uint32_t begin);
+std::shared_ptr<const PixelList> adaptivePixels(const Film& film, uint32_t begin, const PixelList* before,
+                                                uint32_t beforeLength);
 
 }  // namespace fh

@@ -20,8 +20,9 @@ namespace {
 
 // Version 2: the header lists the passes the film holds (chunks, ranks' films), and samples
 // are quantized (render/film.h). Version 3: the odd passes' sums carry their sample count
-// (an adaptive render's pixels have counts of their own).
-constexpr const char* kMagic = "fredholm-film-3";
+// (an adaptive render's pixels have counts of their own). Version 4: an adaptive render's
+// film lists the pixels of the round after its current one too.
+constexpr const char* kMagic = "fredholm-film-4";
 
 // FNV-1a, 64 bits, over whatever bytes are fed to it.
 class Fingerprint {
@@ -79,11 +80,13 @@ void saveFilm(const std::string& path, const Film& film, const std::string& fing
   std::ostringstream out;
   out << kMagic << ' ' << fingerprint << ' ' << film.width << ' ' << film.height << ' ' << film.passRanges().size();
   for (const auto& [begin, end] : film.passRanges()) out << ' ' << begin << ' ' << end;
-  const size_t round = film.roundPixels ? film.roundPixels->size() : 0;
-  out << ' ' << film.aovSum.size() << ' ' << film.oddSum.size() << ' ' << round << '\n';
+  const auto size = [](const auto& list) { return list ? list->size() : 0; };
+  out << ' ' << film.aovSum.size() << ' ' << film.oddSum.size() << ' ' << size(film.roundPixels) << ' '
+      << size(film.nextRoundPixels) << '\n';
   for (const std::vector<double>* v : sums(film))
     out.write(reinterpret_cast<const char*>(v->data()), std::streamsize(v->size() * 8));
-  if (round) out.write(reinterpret_cast<const char*>(film.roundPixels->data()), std::streamsize(round * 4));
+  for (const auto& list : {film.roundPixels, film.nextRoundPixels})
+    if (list) out.write(reinterpret_cast<const char*>(list->data()), std::streamsize(list->size() * 4));
   writeTextAtomically(path, flag, out.str());
 }
 
@@ -96,7 +99,7 @@ SavedFilm readFilm(const std::string& path, const std::string& flag) {
   if (!in) throw Error(flag + " '" + path + "': cannot read the file");
   std::string magic, saved;
   int width = 0, height = 0;
-  size_t rangeCount = 0, aovs = 0, odd = 0, round = 0;
+  size_t rangeCount = 0, aovs = 0, odd = 0, round = 0, nextRound = 0;
   const std::string notAFilm = flag + " '" + path + "': not a fredholm film or checkpoint";
   in >> magic >> saved >> width >> height >> rangeCount;
   if (!in || magic != kMagic || rangeCount > 4096) throw Error(notAFilm);
@@ -110,31 +113,35 @@ SavedFilm readFilm(const std::string& path, const std::string& flag) {
       throw Error(notAFilm);
     passes += ranges[i].second - ranges[i].first;
   }
-  in >> aovs >> odd >> round;
+  in >> aovs >> odd >> round >> nextRound;
   if (!in || in.get() != '\n' || width <= 0 || height <= 0 || uint64_t(width) * uint64_t(height) > (uint64_t(1) << 28))
     throw Error(notAFilm);
   // The sums' sizes follow from the header: checked against the file before allocating.
   const uint64_t pixels = uint64_t(width) * uint64_t(height);
   if ((aovs != 0 && aovs != pixels * kAovSumsPerPixel) || (odd != 0 && odd != pixels * kOddSumsPerPixel) ||
-      round > pixels)
+      round > pixels || nextRound > pixels || (nextRound && !round))
     throw Error(notAFilm);
   const auto body = in.tellg();
   in.seekg(0, std::ios::end);
   const uint64_t bytes = uint64_t(in.tellg() - body);
   in.seekg(body);
-  if (bytes != (8 * pixels + aovs + odd) * 8 + round * 4) throw Error(flag + " '" + path + "': the file is cut short");
+  if (bytes != (8 * pixels + aovs + odd) * 8 + (round + nextRound) * 4) throw Error(flag + " '" + path + "': the file is cut short");
   SavedFilm f{Film(width, height, aovs > 0, odd > 0, ranges.empty() ? 0 : ranges.front().first), saved};
   for (std::vector<double>* v : sums(f.film))
     if (!in.read(reinterpret_cast<char*>(v->data()), std::streamsize(v->size() * 8)))
       throw Error(flag + " '" + path + "': the file is cut short");
-  if (round) {
-    auto pixelList = std::make_shared<std::vector<uint32_t>>(round);
-    if (!in.read(reinterpret_cast<char*>(pixelList->data()), std::streamsize(round * 4)))
+  // A pixel list: ascending pixel indices.
+  const auto readList = [&](size_t length) -> std::shared_ptr<const std::vector<uint32_t>> {
+    if (!length) return nullptr;
+    auto list = std::make_shared<std::vector<uint32_t>>(length);
+    if (!in.read(reinterpret_cast<char*>(list->data()), std::streamsize(length * 4)))
       throw Error(flag + " '" + path + "': the file is cut short");
-    for (size_t i = 0; i < round; ++i)  // ascending pixel indices
-      if ((*pixelList)[i] >= pixels || (i > 0 && (*pixelList)[i] <= (*pixelList)[i - 1])) throw Error(notAFilm);
-    f.film.roundPixels = std::move(pixelList);
-  }
+    for (size_t i = 0; i < length; ++i)
+      if ((*list)[i] >= pixels || (i > 0 && (*list)[i] <= (*list)[i - 1])) throw Error(notAFilm);
+    return list;
+  };
+  f.film.roundPixels = readList(round);
+  f.film.nextRoundPixels = readList(nextRound);
   if (in.peek() != std::char_traits<char>::eof()) throw Error(notAFilm);
   // Every pass adds one sample to each pixel it covers: every pixel, but in an adaptive
   // render's film (one that lists its round's pixels), whose pixels have counts of their own.

@@ -97,9 +97,11 @@ struct Film {
   std::vector<double> aovSum;
   // With two replicates: per pixel, the rgb sums of the odd passes and their sample count.
   std::vector<double> oddSum;
-  // An adaptive render's film (render/adaptive.h): the pixels its last round's passes cover,
-  // so a render resumed from it mid-round goes on with that round; null: every pixel.
-  std::shared_ptr<const std::vector<uint32_t>> roundPixels;
+  // An adaptive render's film (render/adaptive.h): the pixels covered by the round its next
+  // pass is in and by the round after it, both chosen before the film got here, so that a
+  // render resumed from it goes on with them; null: not recorded (the first two rounds
+  // cover every pixel).
+  std::shared_ptr<const std::vector<uint32_t>> roundPixels, nextRoundPixels;
 
  private:
   std::vector<float> aovMean(size_t first) const;

@@ -36,19 +36,26 @@ PassPool::PassPool(const RenderSettings& s, int workers)
   next_ = nextToMerge_ = uint32_t(film_.nextPass());
   mergedSamples_ = film_.samples();
   samplesDone_.assign(size_t(workers), 0);
-  round_ = {total_, nullptr, film_.pixels()};
-  if (s.adaptive) {
+  if (!s.adaptive) {
+    addRound(0, nullptr);
+  } else {
     sampleBudget_ = uint64_t(std::max(1, s.spp)) * film_.pixels();
     samplesHanded_ = uint64_t(mergedSamples_);
-    // A film that ends mid-round (past the first) says which pixels the round covers.
-    const uint32_t begin = adaptiveRoundBegin(next_);
-    const bool midRound = begin != next_ && begin >= kAdaptiveFirstRound;
-    if (midRound && !film_.roundPixels)
-      throw Error("--resume: the film ends in an adaptive round (at pass " + std::to_string(next_) +
-                  ") and does not say which pixels it covers");
-    std::shared_ptr<const PixelList> pixels = midRound ? film_.roundPixels : adaptivePixels(film_, begin);
-    if (pixels && pixels->size() == film_.pixels()) pixels = nullptr;
-    openRound(begin, pixels);
+    // The round the film goes on with and, past its choice point, the one after it, both
+    // chosen before the film got here (the first covers every pixel): a film saved in a
+    // later round lists them.
+    const uint32_t begin = adaptiveRoundBegin(next_), end = adaptiveRoundEnd(begin);
+    const auto missing = [&](const char* which) {
+      return Error("--resume: the film ends in an adaptive round (at pass " + std::to_string(next_) +
+                   ") and does not say which pixels " + which + " covers");
+    };
+    if (begin > 0 && !film_.roundPixels) throw missing("it");
+    addRound(begin, begin > 0 ? film_.roundPixels : nullptr);
+    if (next_ < adaptiveChoicePoint(begin)) {  // the merger chooses it
+    } else if (film_.nextRoundPixels) addRound(end, film_.nextRoundPixels);
+    else if (next_ == adaptiveChoicePoint(begin)) addRound(end, pixelsOfRoundAfter(begin));
+    else throw missing("the round after it");
+    recordRounds();
   }
   // ... unless it met its noise target already (a render that stopped there).
   noiseReached_ = s.resume && s.noise > 0.0 && film_.passes() >= kNoiseMinPasses &&
@@ -95,8 +102,7 @@ bool PassPool::take(int worker, Pass& pass) {
     if (mine || (next == NewPass::None && !anyOutstanding())) return false;
     changed_.wait(lock);
   }
-  // Every pass handed out is of the current round: a round opens once all before it are in.
-  pass.pixels = round_.pixels;
+  pass.pixels = roundOf(pass.index)->pixels;
   outstanding_[size_t(worker)].insert(pass.index);
   return true;
 }
@@ -112,10 +118,11 @@ PassPool::NewPass PassPool::nextNewPass(uint32_t& pass) {
     return NewPass::None;
   }
   if (next_ >= total_ || outOfTime()) return NewPass::None;
+  const Round* round = roundOf(next_);
+  if (!round) return NewPass::Later;
   if (settings_.adaptive) {
-    if (next_ == round_.end) return NewPass::Later;
-    if (samplesHanded_ + round_.size > sampleBudget_) return NewPass::None;
-    samplesHanded_ += round_.size;
+    if (samplesHanded_ + round->size > sampleBudget_) return NewPass::None;
+    samplesHanded_ += round->size;
   }
   pass = next_++;
   return NewPass::Given;
@@ -126,7 +133,7 @@ void PassPool::done(int worker, uint32_t pass, std::vector<float>& samples) {
   std::lock_guard<std::mutex> lock(mutex_);
   outstanding_[size_t(worker)].erase(pass);
   ++done_[size_t(worker)];
-  samplesDone_[size_t(worker)] += round_.size;  // a pass of the current round
+  samplesDone_[size_t(worker)] += roundOf(pass)->size;
   pending_[pass].swap(samples);
   if (!spare_.empty()) {
     samples.swap(spare_.back());
@@ -159,8 +166,9 @@ Film PassPool::finish(bool& complete) {
   complete = noiseReached_ || (pending_.empty() && requeued_.empty() && !anyOutstanding());
   for (auto& [pass, samples] : pending_) {
     if (noiseReached_) break;  // beyond the pass that met the target
-    film_.addPass(pass, samples, round_.pixels.get());
-    mergedSamples_ += double(round_.size);
+    const Round& round = *roundOf(pass);
+    film_.addPass(pass, samples, round.pixels.get());
+    mergedSamples_ += double(round.size);
   }
   pending_.clear();
   if (settings_.ledger) progress_.end();  // other processes may still be rendering
@@ -168,13 +176,38 @@ Film PassPool::finish(bool& complete) {
   return film_;
 }
 
-// The adaptive round from pass `begin` on covers `pixels` (null: every pixel). The film
-// records them for a checkpoint saved during the round, every pixel listed too, so that a
-// render resumed from it knows the round whatever it covers.
-void PassPool::openRound(uint32_t begin, std::shared_ptr<const PixelList> pixels) {
-  round_ = {adaptiveRoundEnd(begin), pixels, pixels ? pixels->size() : film_.pixels()};
-  if (!pixels && begin >= kAdaptiveFirstRound) pixels = std::make_shared<const PixelList>(everyPixel(film_.pixels()));
-  film_.roundPixels = std::move(pixels);
+// The round from pass `begin` on covers `pixels` (null, or every pixel listed: every pixel).
+void PassPool::addRound(uint32_t begin, std::shared_ptr<const PixelList> pixels) {
+  if (pixels && pixels->size() == film_.pixels()) pixels = nullptr;
+  const size_t size = pixels ? pixels->size() : film_.pixels();
+  rounds_.push_back({begin, settings_.adaptive ? adaptiveRoundEnd(begin) : total_, std::move(pixels), size});
+}
+
+const PassPool::Round* PassPool::roundOf(uint32_t pass) const {
+  for (const Round& r : rounds_)
+    if (pass >= r.begin && pass < r.end) return &r;
+  return nullptr;
+}
+
+// The pixels of the round after the one from pass `begin` on, chosen from the film, which
+// holds every pass before that round's choice point (the film is the merger's alone, as is
+// adding rounds).
+std::shared_ptr<const PixelList> PassPool::pixelsOfRoundAfter(uint32_t begin) const {
+  const Round& round = *roundOf(begin);
+  return adaptivePixels(film_, round.end, round.pixels.get(), round.end - adaptiveChoicePoint(begin));
+}
+
+// What a checkpoint of the film needs to go on: the pixels of the round its next pass is
+// in and, once chosen, of the round after it (every pixel listed, where they cover every
+// pixel); none in the first round.
+void PassPool::recordRounds() {
+  const auto listed = [&](const Round* r) -> std::shared_ptr<const PixelList> {
+    if (!r || r->begin < kAdaptiveFirstRound) return nullptr;
+    return r->pixels ? r->pixels : std::make_shared<const PixelList>(everyPixel(film_.pixels()));
+  };
+  const Round* current = roundOf(nextToMerge_);
+  film_.roundPixels = listed(current);
+  film_.nextRoundPixels = film_.roundPixels ? listed(roundOf(current->end)) : nullptr;
 }
 
 bool PassPool::anyOutstanding() const {
@@ -198,22 +231,25 @@ void PassPool::mergeInOrder() {
     samples.swap(next->second);
     const uint32_t pass = next->first;
     pending_.erase(next);
+    const Round round = *roundOf(pass);  // the merger alone adds and drops rounds
     lock.unlock();
-    film_.addPass(pass, samples, round_.pixels.get());  // the pass's round: it is the merger's to change
+    film_.addPass(pass, samples, round.pixels.get());
     const bool check = settings_.noise > 0.0 && film_.passes() >= kNoiseMinPasses;
     const double estimate = check ? film_.estimatedRelMse() : -1.0;
     if (settings_.ledger) settings_.ledger->finished(pass);
-    // The last pass of an adaptive round: the film holds every pass before the next round,
-    // which its pixels are chosen from (round_ is written by this thread alone).
-    const bool roundEnds = settings_.adaptive && pass + 1 == round_.end;
-    const auto nextPixels = roundEnds ? adaptivePixels(film_, round_.end) : nullptr;
+    // At an adaptive round's choice point, the round after it is chosen.
+    const bool chooses = settings_.adaptive && pass + 1 == adaptiveChoicePoint(round.begin);
+    auto following = chooses ? pixelsOfRoundAfter(round.begin) : nullptr;
     lock.lock();
     spare_.push_back(std::move(samples));
     ++nextToMerge_;
-    mergedSamples_ += double(round_.size);
-    if (roundEnds) {
-      openRound(round_.end, nextPixels);
-      changed_.notify_all();  // workers wait for the round
+    mergedSamples_ += double(round.size);
+    const bool ends = settings_.adaptive && pass + 1 == round.end;
+    if (ends) rounds_.pop_front();
+    if (chooses) addRound(round.end, std::move(following));
+    if (chooses || ends) {
+      recordRounds();
+      changed_.notify_all();  // workers may wait for the round
     }
     checkpoint(false);
     if (check) noiseEstimate_ = estimate;

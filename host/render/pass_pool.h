@@ -8,8 +8,9 @@
 // for a seed and target is the same whichever devices rendered and however fast.
 //
 // An adaptive render's passes come in rounds (render/adaptive.h): the merger chooses a
-// round's pixels once every earlier pass is in the film, and workers wait for it. Its
-// sample count is a budget: spp times the pixels, over whichever pixels the rounds cover.
+// round's pixels once the film holds every pass before the round before it, and workers
+// wait for them only if they get that far ahead. Its sample count is a budget: spp times
+// the pixels, over whichever pixels the rounds cover.
 #pragma once
 #include <chrono>
 #include <condition_variable>
@@ -51,9 +52,18 @@ class PassPool : public PassSource {
 
  private:
   bool anyOutstanding() const;
-  enum class NewPass { Given, Later, None };  // Later: once the merger opens the next round
+  enum class NewPass { Given, Later, None };  // Later: once the merger chooses the next round
   NewPass nextNewPass(uint32_t& pass);
-  void openRound(uint32_t begin, std::shared_ptr<const PixelList> pixels);
+  // Runs of passes over the same pixels: every pass of a render but an adaptive one's in one.
+  struct Round {
+    uint32_t begin = 0, end = 0;
+    std::shared_ptr<const PixelList> pixels;  // null: every pixel
+    size_t size = 0;                          // pixels covered
+  };
+  void addRound(uint32_t begin, std::shared_ptr<const PixelList> pixels);
+  const Round* roundOf(uint32_t pass) const;  // null: its pixels are not chosen yet
+  std::shared_ptr<const PixelList> pixelsOfRoundAfter(uint32_t begin) const;
+  void recordRounds();
   bool outOfTime() const;
   void mergeInOrder();
   void stopMerging();
@@ -68,13 +78,8 @@ class PassPool : public PassSource {
   bool started_ = false;
   uint32_t next_ = 0, nextToMerge_ = 0;
   double mergedSamples_ = 0;  // in the film: what the progress display counts
-  // The passes handed out now cover these pixels, up to pass `end` (every pixel and every
-  // pass but in an adaptive render).
-  struct Round {
-    uint32_t end = 0;
-    std::shared_ptr<const PixelList> pixels;  // null: every pixel
-    size_t size = 0;                          // pixels covered
-  } round_;
+  // The rounds whose pixels are known, in order, from the one being merged on.
+  std::deque<Round> rounds_;
   uint64_t sampleBudget_ = 0, samplesHanded_ = 0;  // an adaptive render's
   std::vector<uint64_t> samplesDone_;
   std::deque<uint32_t> requeued_;
