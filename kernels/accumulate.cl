@@ -11,12 +11,12 @@
 // buffers, a non-finite value as zero; returns which were finite and sets *pass_slot to
 // their pass slots.
 FH_INLINE lmask record_samples(luint p, lmask active, __global float4* pass_buffer, luint* pass_slot FH_PATH_PARAMS) {
-  const luint code = gather_uint(pass_entry, p), entry = code / FH_MAX_PASS_SLOTS;
+  const luint code = gather_uint(pass_entry, p);
   lvec3 value = gather_xyz(radiance, p);
   const lmask finite = isfinite(value.x) && isfinite(value.y) && isfinite(value.z);
   value = v3_select(finite, value, v3_splat(0.0f));
-  scatter_xyzw(pass_buffer, entry, value, (lfloat)(1.0f), active);
-  *pass_slot = code % FH_MAX_PASS_SLOTS;
+  scatter_xyzw(pass_buffer, FH_PASS_ENTRY_INDEX(code), value, (lfloat)(1.0f), active);
+  *pass_slot = FH_PASS_ENTRY_SLOT(code);
   return finite;
 }
 

@@ -18,7 +18,7 @@
 
 // The entry of path p's sample in the AOV buffers.
 FH_INLINE luint aov_entry(luint p, __global const uint* pass_entry) {
-  return FH_AOV_FLOAT4S * (gather_uint(pass_entry, p) / FH_MAX_PASS_SLOTS);
+  return FH_AOV_FLOAT4S * FH_PASS_ENTRY_INDEX(gather_uint(pass_entry, p));
 }
 
 // What a denoiser takes as a surface's albedo: its diffuse and specular reflectance.

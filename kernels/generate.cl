@@ -38,7 +38,7 @@ FH_INLINE void start_sample(RenderParams params, PassShape older, PassShape newe
   scatter_float(ray_pdf, slot, (lfloat)(0.0f), active);
   scatter_xyzw(radiance, slot, v3_splat(0.0f), (lfloat)(0.0f), active);
   scatter_uint(sample_id, slot, k, active);
-  scatter_uint(pass_entry, slot, (j % entries) * FH_MAX_PASS_SLOTS + pass_slot, active);
+  scatter_uint(pass_entry, slot, FH_PASS_ENTRY(j % entries, pass_slot), active);
   scatter_uint(depth, slot, (luint)(0), active);
 }
 

@@ -15,7 +15,7 @@
   X(float, ray_pdf, 4)          /* pdf with which the BSDF sampled ray_dir (MIS); < 0: delta */ \
   X(float4, radiance, 16)       /* rgb gathered so far */                                        \
   X(uint, sample_id, 4)         /* global sample index: pixel = id % pixels, pass = id / pixels */ \
-  X(uint, pass_entry, 4)        /* entry in the pass buffers * FH_MAX_PASS_SLOTS + pass slot */  \
+  X(uint, pass_entry, 4)        /* entry in the pass buffers and pass slot: FH_PASS_ENTRY */     \
   X(uint, depth, 4)             /* bounces so far */
 
 // The light-sample requests shade hands to shadow_connect, stored by queue position (so

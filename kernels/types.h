@@ -90,6 +90,10 @@ typedef struct {
 // waiting for any: it reads this back only now and then. 64-bit totals are (low, high)
 // pairs, as OpenCL 1.2 has no 64-bit atomics to rely on.
 #define FH_MAX_PASS_SLOTS 64  // passes in flight at most: local pass p is in pass slot p % this
+// A path's pass_entry: its sample's entry in the pass buffers and its pass's slot, in one uint.
+#define FH_PASS_ENTRY(entry, slot) ((entry) * FH_MAX_PASS_SLOTS + (slot))
+#define FH_PASS_ENTRY_INDEX(pass_entry) ((pass_entry) / FH_MAX_PASS_SLOTS)
+#define FH_PASS_ENTRY_SLOT(pass_entry) ((pass_entry) % FH_MAX_PASS_SLOTS)
 
 // The shape of a run of passes: each covers `pixels` pixels, those listed from `list` on in
 // the pixel list (every pixel, or an adaptive round's, render/adaptive.h); its first pass is

@@ -203,7 +203,9 @@ std::shared_ptr<const PixelList> PassPool::pixelsOfRoundAfter(uint32_t begin) co
 void PassPool::recordRounds() {
   const auto listed = [&](const Round* r) -> std::shared_ptr<const PixelList> {
     if (!r || r->begin < kAdaptiveFirstRound) return nullptr;
-    return r->pixels ? r->pixels : std::make_shared<const PixelList>(everyPixel(film_.pixels()));
+    if (r->pixels) return r->pixels;
+    if (!everyPixel_) everyPixel_ = std::make_shared<const PixelList>(everyPixel(film_.pixels()));
+    return everyPixel_;
   };
   const Round* current = roundOf(nextToMerge_);
   film_.roundPixels = listed(current);

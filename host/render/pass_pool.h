@@ -80,6 +80,7 @@ class PassPool : public PassSource {
   double mergedSamples_ = 0;  // in the film: what the progress display counts
   // The rounds whose pixels are known, in order, from the one being merged on.
   std::deque<Round> rounds_;
+  std::shared_ptr<const PixelList> everyPixel_;  // a checkpoint's list for rounds of every pixel
   uint64_t sampleBudget_ = 0, samplesHanded_ = 0;  // an adaptive render's
   std::vector<uint64_t> samplesDone_;
   std::deque<uint32_t> requeued_;
