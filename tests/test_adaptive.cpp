@@ -245,7 +245,7 @@ TEST(AdaptiveCli, AResumedRenderFinishesItsRound) {
   const std::string dir = test::tempDir("adaptive-resume");
   ASSERT_EQ(test::runFredholm(kAdaptive + " -o " + dir + "/straight.exr").exitCode, 0);
   const Image straight = readImage(dir + "/straight.exr");
-  for (const char* passes : {"10", "16", "21", "32", "70"}) {
+  for (const char* passes : {"10", "16", "21", "26", "32", "70", "85"}) {
     const std::string ckpt = dir + "/c" + passes + ".fhc", out = dir + "/r" + passes + ".exr";
     const auto killed = test::runFredholm(kAdaptive + " --checkpoint " + ckpt + " --checkpoint-every 0 -o " + out,
                                           std::string("FREDHOLM_KILL_AFTER_PASSES=") + passes);
