@@ -1,5 +1,6 @@
-// Binned SAH build (32 bins, all three axes), with subtrees built in parallel, and the
-// collapse into 8-wide nodes.
+// Binned SAH build with spatial splits (Stich, Friedrich and Dietrich, "Spatial Splits in
+// Bounding Volume Hierarchies", HPG 2009), subtrees built in parallel, and the collapse into
+// 8-wide nodes.
 #include "accel/bvh.h"
 
 #include <algorithm>
@@ -16,11 +17,22 @@ namespace fh {
 namespace {
 
 constexpr int kBins = 32;
+constexpr int kSpatialBins = 32;
+constexpr int kMaxBins = std::max(kBins, kSpatialBins);
 constexpr unsigned kMaxLeaf = FH_MAX_LEAF_TRIANGLES;
 // SAH costs relative to one box test. A leaf's triangles are tested eight at a time
 // (TriangleBlock8), so a triangle costs a fraction of a box test and leaves fill up.
 constexpr float kTraversalCost = 1.0f;
 constexpr float kTriangleCost = 0.15f;
+// Spatial splits are tried where the best object split's children overlap by more than
+// this fraction of the root's area (Stich et al.'s alpha, who use 1e-5): below it they gain
+// little, and trying them costs a clipping pass over the node's references.
+constexpr float kOverlapToTrySpatial = 1e-2f;
+// A spatial split is taken only where it costs this fraction less than the best object
+// split. The greedy estimate (children as leaves) overrates small gains near the root of a
+// big tree: on the 1M-triangle scene, splits that won narrowly there left the whole
+// tree worse. Where spatial splits pay (long overlapping triangles), they win by far more.
+constexpr float kSpatialSplitGain = 0.05f;
 
 // Grown with plain comparisons (std::min/max), which compile inline: fminf/fmaxf, which
 // must handle NaNs (scenes have none: the loader rejects them), were library calls on
@@ -36,65 +48,125 @@ struct Box {
       hi[k] = std::max(hi[k], high[k]);
     }
   }
+  bool empty() const { return lo[0] > hi[0] || lo[1] > hi[1] || lo[2] > hi[2]; }
   float area() const {
-    if (lo[0] > hi[0]) return 0.f;
+    if (empty()) return 0.f;
     const float3 e = hi - lo;
     return 2.f * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]);
   }
+  float3 centroid() const { return (lo + hi) * 0.5f; }
+  static Box overlap(const Box& a, const Box& b) {
+    Box o;
+    for (size_t k = 0; k < 3; ++k) {
+      o.lo[k] = std::max(a.lo[k], b.lo[k]);
+      o.hi[k] = std::min(a.hi[k], b.hi[k]);
+    }
+    return o;
+  }
+};
+
+// A triangle, or the part of it inside `box` once spatial splits have cut it: a triangle
+// may have several references, in different subtrees, whose boxes bound its pieces.
+struct Reference {
+  Box box;
+  unsigned triangle;
+};
+
+// A builder's view of the references it partitions (in place, where splits add none).
+struct References {
+  Reference* first;
+  Reference* last;
+  size_t size() const { return size_t(last - first); }
+  Reference* begin() const { return first; }
+  Reference* end() const { return last; }
 };
 
 struct BinaryNode {
   Box box;
   int left = -1, right = -1;  // children when count == 0
-  unsigned first = 0, count = 0;
+  unsigned first = 0, count = 0;  // a leaf's triangles: leafTriangles[first, first + count)
 };
 
-// The triangles a build partitions: boxes and centroids by file-order id, and the ids in
-// the order the build arranges them (each subtree owns a contiguous range).
-struct Primitives {
-  std::vector<Box> boxes;
-  std::vector<float3> centroids;
-  std::vector<unsigned> index;
+// A binary tree and the file-order ids of its leaves' triangles, leaf after leaf depth first.
+struct BinaryTree {
+  std::vector<BinaryNode> nodes;
+  std::vector<unsigned> leafTriangles;
 };
 
-// Boxes and centroids of every triangle, on `threads` threads.
-Primitives gatherPrimitives(const Scene& scene, unsigned threads) {
-  Primitives p;
-  const size_t n = scene.triangleCount();
-  p.boxes.resize(n);
-  p.centroids.resize(n);
-  p.index.resize(n);
+// A reference per triangle, with the triangle's box, and the triangles' corners side by
+// side (three per triangle, for clipping), on `threads` threads.
+std::vector<Reference> triangleReferences(const Scene& scene, unsigned threads, std::vector<float3>& corners) {
+  std::vector<Reference> refs(scene.triangleCount());
+  const size_t n = refs.size();
+  corners.resize(3 * n);
   auto range = [&](size_t begin, size_t end) {
     for (size_t t = begin; t < end; ++t) {
-      for (int k = 0; k < 3; ++k) p.boxes[t].grow(scene.corner(t, k));
-      p.centroids[t] = (p.boxes[t].lo + p.boxes[t].hi) * 0.5f;
-      p.index[t] = unsigned(t);
+      for (size_t k = 0; k < 3; ++k) {
+        corners[3 * t + k] = scene.corner(t, int(k));
+        refs[t].box.grow(corners[3 * t + k]);
+      }
+      refs[t].triangle = unsigned(t);
     }
   };
   std::vector<std::thread> workers;
   for (unsigned w = 1; w < threads; ++w) workers.emplace_back(range, n * w / threads, n * (w + 1) / threads);
   range(0, n / threads);
   for (auto& w : workers) w.join();
-  return p;
+  return refs;
+}
+
+// The boxes of a reference's triangle piece on either side of the plane x[axis] = position
+// (either may be empty). The crossing points of edges with the plane are widened by the
+// rounding of their interpolation, so the boxes stay conservative and no ray slips between
+// the two.
+std::pair<Box, Box> splitReference(const float3* corners, const Reference& ref, int axis, float position) {
+  const size_t a = size_t(axis);
+  const float3* v = corners + 3 * size_t(ref.triangle);
+  Box left, right;
+  for (size_t k = 0; k < 3; ++k) {
+    const float3& p = v[k];
+    const float3& q = v[k == 2 ? 0 : k + 1];
+    if (p[a] <= position) left.grow(p);
+    if (p[a] >= position) right.grow(p);
+    if ((p[a] < position && q[a] > position) || (p[a] > position && q[a] < position)) {
+      const float s = (position - p[a]) / (q[a] - p[a]);
+      float3 lo, hi;
+      for (size_t c = 0; c < 3; ++c) {
+        const float x = p[c] + (q[c] - p[c]) * s, slack = std::max(std::fabs(p[c]), std::fabs(q[c])) * 0x1p-20f;
+        lo[c] = x - slack;
+        hi[c] = x + slack;
+      }
+      lo[a] = hi[a] = position;
+      left.grow(lo, hi);
+      right.grow(lo, hi);
+    }
+  }
+  left.hi[a] = std::min(left.hi[a], position);
+  right.lo[a] = std::max(right.lo[a], position);
+  return {Box::overlap(left, ref.box), Box::overlap(right, ref.box)};
 }
 
 // Subtrees at least this large build their second child on a thread of its own (while the
 // tree is shallower than parallelDepth): smaller ones cost less than starting a thread.
 constexpr unsigned kParallelTriangles = 16384;
 
-// A binary subtree over primitives' index range, root at node 0, children depth first
-// (left subtree, then right). Large right subtrees are built concurrently by builders of
-// their own and grafted in at the index a serial build gives them, so the tree is the same
-// whatever the thread count.
+// A binary subtree over references, root at node 0, children depth first (left subtree,
+// then right). Large right subtrees are built concurrently by builders of their own and
+// grafted in at the index a serial build gives them, so the tree is the same whatever the
+// thread count. A subtree may add up to `room` references by spatial splits; what a split
+// leaves of it is shared by the children in proportion to their references, so the
+// budget, too, does not depend on the order subtrees are built in.
 class BinaryBuilder {
  public:
-  BinaryBuilder(Primitives& primitives, int parallelDepth) : p_(primitives), parallelDepth_(parallelDepth) {}
+  BinaryBuilder(const float3* corners, float rootArea, int parallelDepth)
+      : corners_(corners), rootArea_(rootArea), parallelDepth_(parallelDepth) {}
 
-  std::vector<BinaryNode> build(unsigned first, unsigned count, int depth = 0) {
-    nodes_.reserve(2 * size_t(count));
-    nodes_.emplace_back();
-    split(0, first, count, depth);
-    return std::move(nodes_);
+  BinaryTree build(References refs, size_t room, int depth = 0) {
+    tree_.nodes.reserve(2 * refs.size());
+    tree_.leafTriangles.reserve(refs.size());
+    tree_.nodes.emplace_back();
+    split(0, refs, room, depth);
+    return std::move(tree_);
   }
 
  private:
@@ -102,111 +174,231 @@ class BinaryBuilder {
     int axis = -1;
     float position = 0.f;
     float cost = INFINITY;
+    bool spatial = false;
+    Box left, right;  // the children's boxes
+    size_t leftCount = 0, rightCount = 0;
   };
 
-  Split findSplit(unsigned first, unsigned count, const Box& centroidBox, float parentArea) const {
+  float cost(const Box& left, size_t nLeft, const Box& right, size_t nRight, float parentArea) const {
+    return kTraversalCost + kTriangleCost * (left.area() * float(nLeft) + right.area() * float(nRight)) / parentArea;
+  }
+
+  // Binned over the references' centroids, all three axes in one pass over them.
+  Split objectSplit(References refs, const Box& centroidBox, float parentArea) const {
+    Box bins[3][kBins];
+    size_t counts[3][kBins] = {};
+    float scale[3];
+    for (size_t a = 0; a < 3; ++a) {
+      const float extent = centroidBox.hi[a] - centroidBox.lo[a];
+      scale[a] = extent > 0.f ? kBins / extent : 0.f;
+    }
+    for (const Reference& r : refs) {
+      const float3 c = r.box.centroid();
+      for (size_t a = 0; a < 3; ++a) {
+        const int b = std::min(kBins - 1, int((c[a] - centroidBox.lo[a]) * scale[a]));
+        bins[a][b].grow(r.box);
+        ++counts[a][b];
+      }
+    }
     Split best;
     for (int axis = 0; axis < 3; ++axis) {
-      const float lo = centroidBox.lo[size_t(axis)], extent = centroidBox.hi[size_t(axis)] - lo;
-      if (!(extent > 0.f)) continue;
-      Box bins[kBins];
-      unsigned counts[kBins] = {};
-      const float scale = kBins / extent;
-      for (unsigned i = first; i < first + count; ++i) {
-        const unsigned t = p_.index[i];
-        const int b = std::min(kBins - 1, int((p_.centroids[t][size_t(axis)] - lo) * scale));
-        bins[b].grow(p_.boxes[t]);
-        ++counts[b];
-      }
-      // Sweep from the right to get the right-side areas, then from the left.
-      float rightArea[kBins];
-      unsigned rightCount[kBins];
-      Box acc;
-      unsigned n = 0;
-      for (int b = kBins - 1; b > 0; --b) {
-        acc.grow(bins[b]);
-        n += counts[b];
-        rightArea[b] = acc.area();
-        rightCount[b] = n;
-      }
-      acc = Box();
-      n = 0;
-      for (int b = 0; b < kBins - 1; ++b) {
-        acc.grow(bins[b]);
-        n += counts[b];
-        if (n == 0 || rightCount[b + 1] == 0) continue;
-        const float cost =
-            kTraversalCost + kTriangleCost * (acc.area() * n + rightArea[b + 1] * rightCount[b + 1]) / parentArea;
-        if (cost < best.cost) best = {axis, lo + (b + 1) / scale, cost};
-      }
+      const float lo = centroidBox.lo[size_t(axis)], binScale = scale[axis];
+      if (binScale == 0.f) continue;
+      sweep(bins[axis], counts[axis], counts[axis], kBins, parentArea,
+            [&](int b) { return lo + float(b + 1) / binScale; }, axis, false, best);
     }
     return best;
   }
 
-  void makeLeaf(int node, unsigned first, unsigned count) {
-    nodes_[size_t(node)].first = first;
-    nodes_[size_t(node)].count = count;
+  // Binned over the node's box: each reference is cut at the bin planes it spans, its pieces
+  // grow the bins, and it enters the bin of its lowest piece and leaves by its highest.
+  Split spatialSplit(References refs, const Box& box, float parentArea) const {
+    Split best;
+    for (int axis = 0; axis < 3; ++axis) {
+      const size_t a = size_t(axis);
+      const float lo = box.lo[a], extent = box.hi[a] - lo;
+      if (!(extent > 0.f)) continue;
+      const float width = extent / kSpatialBins;
+      auto plane = [&](int b) { return lo + float(b + 1) * width; };
+      auto binOf = [&](float x) { return std::clamp(int((x - lo) / width), 0, kSpatialBins - 1); };
+      Box bins[kSpatialBins];
+      size_t enter[kSpatialBins] = {}, leave[kSpatialBins] = {};
+      for (const Reference& r : refs) {
+        const int first = binOf(r.box.lo[a]), last = std::max(first, binOf(r.box.hi[a]));
+        ++enter[first];
+        ++leave[last];
+        Reference rest = r;
+        for (int b = first; b < last; ++b) {
+          const auto [piece, above] = splitReference(corners_, rest, axis, plane(b));
+          bins[b].grow(piece);
+          rest.box = above;
+        }
+        bins[last].grow(rest.box);
+      }
+      sweep(bins, enter, leave, kSpatialBins, parentArea, plane, axis, true, best);
+    }
+    return best;
   }
 
-  void split(int node, unsigned first, unsigned count, int depth) {
-    Box box, centroidBox;
-    for (unsigned i = first; i < first + count; ++i) {
-      box.grow(p_.boxes[p_.index[i]]);
-      centroidBox.grow(p_.centroids[p_.index[i]]);
+  // The SAH cost of each plane between bins: the left side counts the references that
+  // enter its bins, the right side those that leave by its bins.
+  template <typename Plane>
+  void sweep(const Box* bins, const size_t* enter, const size_t* leave, int n, float parentArea, Plane plane,
+             int axis, bool spatial, Split& best) const {
+    Box rightBox[kMaxBins + 1];
+    size_t rightCount[kMaxBins + 1] = {};
+    for (int b = n - 1; b > 0; --b) {
+      rightBox[size_t(b)] = rightBox[size_t(b) + 1];
+      rightBox[size_t(b)].grow(bins[b]);
+      rightCount[size_t(b)] = rightCount[size_t(b) + 1] + leave[b];
     }
-    nodes_[size_t(node)].box = box;
-    if (count == 1) return makeLeaf(node, first, count);
+    Box left;
+    size_t leftCount = 0;
+    for (int b = 0; b < n - 1; ++b) {
+      left.grow(bins[b]);
+      leftCount += enter[b];
+      const size_t right = rightCount[size_t(b) + 1];
+      if (leftCount == 0 || right == 0) continue;
+      const float c = cost(left, leftCount, rightBox[size_t(b) + 1], right, parentArea);
+      if (c < best.cost) best = {axis, plane(b), c, spatial, left, rightBox[size_t(b) + 1], leftCount, right};
+    }
+  }
+
+  void makeLeaf(int node, References refs) {
+    tree_.nodes[size_t(node)].first = unsigned(tree_.leafTriangles.size());
+    tree_.nodes[size_t(node)].count = unsigned(refs.size());
+    for (const Reference& r : refs) tree_.leafTriangles.push_back(r.triangle);
+  }
+
+  // Sends each reference to the side of the plane its box is on; one that straddles it is
+  // cut in two, unless putting it whole on one side costs less (Stich et al.'s reference
+  // unsplitting), which also spares the budget.
+  void partitionSpatial(References refs, const Split& s, std::vector<Reference>& left,
+                        std::vector<Reference>& right) const {
+    const size_t a = size_t(s.axis);
+    const float nl = float(s.leftCount), nr = float(s.rightCount);
+    const float splitCost = s.left.area() * nl + s.right.area() * nr;
+    for (const Reference& r : refs) {
+      if (r.box.hi[a] <= s.position) {
+        left.push_back(r);
+      } else if (r.box.lo[a] >= s.position) {
+        right.push_back(r);
+      } else {
+        Box grownLeft = s.left, grownRight = s.right;
+        grownLeft.grow(r.box);
+        grownRight.grow(r.box);
+        const float wholeLeft = grownLeft.area() * nl + s.right.area() * (nr - 1.f);
+        const float wholeRight = s.left.area() * (nl - 1.f) + grownRight.area() * nr;
+        const auto [lo, hi] = splitReference(corners_, r, s.axis, s.position);
+        if (lo.empty()) {
+          right.push_back({hi, r.triangle});
+        } else if (hi.empty()) {
+          left.push_back({lo, r.triangle});
+        } else if (wholeLeft <= splitCost && wholeLeft <= wholeRight) {
+          left.push_back(r);
+        } else if (wholeRight <= splitCost) {
+          right.push_back(r);
+        } else {
+          left.push_back({lo, r.triangle});
+          right.push_back({hi, r.triangle});
+        }
+      }
+    }
+  }
+
+  void split(int node, References refs, size_t room, int depth) {
+    Box box, centroidBox;
+    for (const Reference& r : refs) {
+      box.grow(r.box);
+      centroidBox.grow(r.box.centroid());
+    }
+    tree_.nodes[size_t(node)].box = box;
+    const size_t count = refs.size();
+    if (count == 1) return makeLeaf(node, refs);
 
     const float area = std::max(box.area(), 1e-30f);
-    const Split s = findSplit(first, count, centroidBox, area);
-    unsigned mid = first;
-    if (s.axis >= 0) {
-      if (count <= kMaxLeaf && kTriangleCost * float(count) <= s.cost) return makeLeaf(node, first, count);
-      auto* begin = p_.index.data() + first;
-      mid = unsigned(std::partition(begin, begin + count,
-                                    [&](unsigned t) { return p_.centroids[t][size_t(s.axis)] < s.position; }) -
-                     p_.index.data());
+    const Split object = objectSplit(refs, centroidBox, area);
+    Split s = object;
+    if (room > 0 && s.axis >= 0 && Box::overlap(s.left, s.right).area() > kOverlapToTrySpatial * rootArea_) {
+      const Split spatial = spatialSplit(refs, box, area);
+      // Only within the budget: a spatial split adds at most the references it cuts.
+      if (spatial.cost < s.cost * (1.f - kSpatialSplitGain) && spatial.leftCount + spatial.rightCount - count <= room) s = spatial;
     }
-    if (mid == first || mid == first + count) {
-      // All centroids coincide (or binning could not separate them).
-      if (count <= kMaxLeaf) return makeLeaf(node, first, count);
-      mid = first + count / 2;
+    if (s.axis >= 0 && count <= kMaxLeaf && kTriangleCost * float(count) <= s.cost) return makeLeaf(node, refs);
+
+    // A spatial split's children own their references (this frame keeps them alive);
+    // an object split's partition the node's in place.
+    std::vector<Reference> leftPieces, rightPieces;
+    References left{refs.first, refs.first}, right{refs.last, refs.last};
+    if (s.spatial) {
+      leftPieces.reserve(s.leftCount);
+      rightPieces.reserve(s.rightCount);
+      partitionSpatial(refs, s, leftPieces, rightPieces);
+      if (leftPieces.empty() || rightPieces.empty()) {
+        s = object;  // unsplitting put every reference on one side: split by objects after all
+      } else {
+        left = {leftPieces.data(), leftPieces.data() + leftPieces.size()};
+        right = {rightPieces.data(), rightPieces.data() + rightPieces.size()};
+      }
     }
-    const int left = int(nodes_.size());
-    nodes_.emplace_back();
-    nodes_.emplace_back();
-    nodes_[size_t(node)].left = left;
-    nodes_[size_t(node)].right = left + 1;
-    const unsigned rightCount = first + count - mid;
-    if (depth < parallelDepth_ && rightCount >= kParallelTriangles) {
-      // The two children own disjoint ranges of the index: the right one on another thread.
-      auto right = std::async(std::launch::async, [this, mid, rightCount, depth] {
-        return BinaryBuilder(p_, parallelDepth_).build(mid, rightCount, depth + 1);
+    if (!s.spatial && s.axis >= 0) {
+      Reference* mid = std::partition(refs.first, refs.last, [&](const Reference& r) {
+        return r.box.centroid()[size_t(s.axis)] < s.position;
       });
-      split(left, first, mid - first, depth + 1);
-      graft(left + 1, right.get());
+      left = {refs.first, mid};
+      right = {mid, refs.last};
+    }
+    if (left.size() == 0 || right.size() == 0) {
+      // All centroids coincide (or binning could not separate them).
+      if (count <= kMaxLeaf) return makeLeaf(node, refs);
+      left = {refs.first, refs.first + count / 2};
+      right = {refs.first + count / 2, refs.last};
+    }
+    const size_t added = left.size() + right.size() - count;
+    const size_t rest = room - std::min(room, added);
+    const size_t leftRoom = size_t(double(rest) * double(left.size()) / double(left.size() + right.size()));
+    const size_t rightRoom = rest - leftRoom;
+
+    const int first = int(tree_.nodes.size());
+    tree_.nodes.emplace_back();
+    tree_.nodes.emplace_back();
+    tree_.nodes[size_t(node)].left = first;
+    tree_.nodes[size_t(node)].right = first + 1;
+    if (depth < parallelDepth_ && right.size() >= kParallelTriangles) {
+      // The two children own disjoint references: the right one on another thread.
+      auto subtree = std::async(std::launch::async, [this, right, rightRoom, depth] {
+        return BinaryBuilder(corners_, rootArea_, parallelDepth_).build(right, rightRoom, depth + 1);
+      });
+      split(first, left, leftRoom, depth + 1);
+      graft(first + 1, subtree.get());
     } else {
-      split(left, first, mid - first, depth + 1);
-      split(left + 1, mid, rightCount, depth + 1);
+      split(first, left, leftRoom, depth + 1);
+      split(first + 1, right, rightRoom, depth + 1);
     }
   }
 
   // Puts a subtree built on its own at `node` (its root) and after the nodes so far (its
-  // other nodes), where a serial build numbers them.
-  void graft(int node, std::vector<BinaryNode> subtree) {
-    const int base = int(nodes_.size()) - 1;  // subtree node i > 0 goes to base + i
-    for (BinaryNode& n : subtree)
+  // other nodes, and its leaves' triangles), where a serial build numbers them.
+  void graft(int node, BinaryTree subtree) {
+    const int base = int(tree_.nodes.size()) - 1;  // subtree node i > 0 goes to base + i
+    const unsigned leafBase = unsigned(tree_.leafTriangles.size());
+    for (BinaryNode& n : subtree.nodes) {
       if (n.count == 0) {
         n.left += base;
         n.right += base;
+      } else {
+        n.first += leafBase;
       }
-    nodes_[size_t(node)] = subtree[0];
-    nodes_.insert(nodes_.end(), subtree.begin() + 1, subtree.end());
+    }
+    tree_.nodes[size_t(node)] = subtree.nodes[0];
+    tree_.nodes.insert(tree_.nodes.end(), subtree.nodes.begin() + 1, subtree.nodes.end());
+    tree_.leafTriangles.insert(tree_.leafTriangles.end(), subtree.leafTriangles.begin(), subtree.leafTriangles.end());
   }
 
-  Primitives& p_;
+  const float3* corners_;
+  float rootArea_;
   int parallelDepth_;
-  std::vector<BinaryNode> nodes_;
+  BinaryTree tree_;
 };
 
 // The surface area heuristic's cost of a binary tree (kTraversalCost per node visited,
@@ -222,9 +414,9 @@ double sahCost(const std::vector<BinaryNode>& nodes) {
 
 class WideCollapser {
  public:
-  WideCollapser(const std::vector<BinaryNode>& binary, const Scene& scene, const std::vector<unsigned>& order,
-                Bvh& out)
-      : binary_(binary), scene_(scene), order_(order), out_(out) {}
+  // bvhIndex[t]: file-order triangle t's index in BVH order, the id its leaves' lanes hold.
+  WideCollapser(const BinaryTree& binary, const Scene& scene, const std::vector<int>& bvhIndex, Bvh& out)
+      : binary_(binary.nodes), leafTriangles_(binary.leafTriangles), scene_(scene), bvhIndex_(bvhIndex), out_(out) {}
 
   void collapseRoot() {
     if (binary_[0].count > 0) {
@@ -242,15 +434,19 @@ class WideCollapser {
  private:
   static void clearNode(gpu::Bvh8Node& n) { std::memset(&n, 0, sizeof n); }
 
-  // The leaf's triangles [first, first + count) in BVH order, as one SoA block.
+  // The leaf's triangles leafTriangles[first, first + count), as one SoA block.
   int addBlock(unsigned first, unsigned count) {
     gpu::TriangleBlock8 block;
     std::memset(&block, 0, sizeof block);
     for (unsigned lane = 0; lane < 8; ++lane) {
-      block.id[lane] = lane < count ? int(first + lane) : -1;
-      if (lane >= count) continue;
+      if (lane >= count) {
+        block.id[lane] = -1;
+        continue;
+      }
+      const unsigned triangle = leafTriangles_[first + lane];
+      block.id[lane] = bvhIndex_[triangle];
       for (int k = 0; k < 3; ++k) {
-        const float3 p = scene_.corner(order_[first + lane], k);
+        const float3 p = scene_.corner(triangle, k);
         for (int axis = 0; axis < 3; ++axis) block.v[k][axis][lane] = p[size_t(axis)];
       }
     }
@@ -305,31 +501,56 @@ class WideCollapser {
   }
 
   const std::vector<BinaryNode>& binary_;
+  const std::vector<unsigned>& leafTriangles_;
   const Scene& scene_;
-  const std::vector<unsigned>& order_;
+  const std::vector<int>& bvhIndex_;
   Bvh& out_;
 };
 
+// BVH order: triangles by their first reference in the leaves, depth first, so a leaf's
+// triangles mostly sit together in the per-triangle arrays. `order` lists them, bvhIndex
+// inverts it.
+void orderTriangles(const BinaryTree& tree, size_t triangles, Bvh& bvh, std::vector<int>& bvhIndex) {
+  bvhIndex.assign(triangles, -1);
+  bvh.order.reserve(triangles);
+  for (unsigned t : tree.leafTriangles)
+    if (bvhIndex[t] < 0) {
+      bvhIndex[t] = int(bvh.order.size());
+      bvh.order.push_back(t);
+    }
+}
+
 }  // namespace
 
-Bvh buildBvh(const Scene& scene, unsigned threads) {
+Bvh buildBvh(const Scene& scene, BvhOptions options) {
   const auto start = std::chrono::steady_clock::now();
-  // FREDHOLM_BVH_THREADS caps the default (bench/RESULTS.md compares thread counts).
+  // FREDHOLM_BVH_THREADS caps the default thread count, FREDHOLM_BVH_SPLITS sets the spatial
+  // split budget (bench/RESULTS.md compares both).
+  unsigned threads = options.threads;
   const char* cap = std::getenv("FREDHOLM_BVH_THREADS");
   if (threads == 0 && cap && *cap) threads = unsigned(std::max(1, std::atoi(cap)));
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+  const char* budget = std::getenv("FREDHOLM_BVH_SPLITS");
+  if (budget && *budget) options.spatialSplitBudget = std::max(0.f, std::strtof(budget, nullptr));
+
   Bvh bvh;
-  Primitives primitives = gatherPrimitives(scene, threads);
+  std::vector<float3> corners;
+  std::vector<Reference> refs = triangleReferences(scene, threads, corners);
+  Box sceneBox;
+  for (const Reference& r : refs) sceneBox.grow(r.box);
   // Levels that fork: enough subtrees for every thread, and some over for uneven splits.
   int parallelDepth = 0;
   while (threads > 1 && (1u << parallelDepth) < 4 * threads) ++parallelDepth;
-  const std::vector<BinaryNode> binary =
-      BinaryBuilder(primitives, parallelDepth).build(0, unsigned(primitives.index.size()));
-  bvh.order = std::move(primitives.index);
-  bvh.stats.binaryNodes = binary.size();
-  bvh.stats.sahCost = sahCost(binary);
+  const size_t room = size_t(double(options.spatialSplitBudget) * double(refs.size()));
+  const BinaryTree binary =
+      BinaryBuilder(corners.data(), std::max(sceneBox.area(), 1e-30f), parallelDepth).build({refs.data(), refs.data() + refs.size()}, room);
+  bvh.stats.binaryNodes = binary.nodes.size();
+  bvh.stats.references = binary.leafTriangles.size();
+  bvh.stats.sahCost = sahCost(binary.nodes);
 
-  WideCollapser(binary, scene, bvh.order, bvh).collapseRoot();
+  std::vector<int> bvhIndex;
+  orderTriangles(binary, scene.triangleCount(), bvh, bvhIndex);
+  WideCollapser(binary, scene, bvhIndex, bvh).collapseRoot();
   bvh.stats.wideNodes = bvh.nodes.size();
 
   bvh.triangles.resize(12 * bvh.order.size());

@@ -1,5 +1,5 @@
 // The bounding volume hierarchy: a binary tree built with the binned surface area
-// heuristic, collapsed into 8-wide nodes (kernels/types.h) for float8 traversal.
+// heuristic and spatial splits, collapsed into 8-wide nodes (kernels/types.h) for float8 traversal.
 #pragma once
 #include <cstddef>
 #include <vector>
@@ -13,6 +13,7 @@ struct BvhStats {
   size_t binaryNodes = 0;
   size_t wideNodes = 0;
   size_t leaves = 0;
+  size_t references = 0;  // triangles in leaves: more than the scene's where spatial splits cut some
   int depth = 0;  // wide levels from the root to the deepest leaf
   double sahCost = 0.0;  // of the binary tree (bvh.cpp: sahCost), in box tests per ray
   double buildSeconds = 0.0;
@@ -31,8 +32,13 @@ struct Bvh {
   int traversalStack() const { return 7 * stats.depth + 1; }
 };
 
-// Builds on `threads` threads (0: every core); the tree is the same for any count.
-Bvh buildBvh(const Scene& scene, unsigned threads = 0);
+struct BvhOptions {
+  unsigned threads = 0;  // 0: every core; the tree is the same for any count
+  // Spatial splits may add up to this many references per triangle (0: object splits only).
+  float spatialSplitBudget = 0.5f;
+};
+
+Bvh buildBvh(const Scene& scene, BvhOptions options = {});
 
 // Puts per-triangle data in BVH order: out[k] = in[order[k]] (stride values per triangle).
 template <typename T>

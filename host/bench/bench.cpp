@@ -247,7 +247,8 @@ void printHeader(const std::vector<DeviceInfo>& devices, const ExternalTracer* e
 
 nlohmann::json sceneSummary(const std::string& name, const Scene& scene, const Bvh& bvh) {
   std::cout << "  " << name << ": BVH " << std::fixed << std::setprecision(3) << bvh.stats.buildSeconds << " s, SAH "
-            << std::setprecision(2) << bvh.stats.sahCost << ", " << std::setprecision(1)
+            << std::setprecision(2) << bvh.stats.sahCost << ", references " << bvh.stats.references << ", "
+            << std::setprecision(1)
             << bvh.bytes() / double(1 << 20) << " MiB ("
             << double(bvh.bytes()) / double(scene.triangleCount()) << " B/triangle), depth " << bvh.stats.depth
             << std::defaultfloat << "\n";
@@ -255,6 +256,7 @@ nlohmann::json sceneSummary(const std::string& name, const Scene& scene, const B
           {"triangles", scene.triangleCount()},
           {"bvh_build_seconds", bvh.stats.buildSeconds},
           {"bvh_sah_cost", bvh.stats.sahCost},
+          {"bvh_references", bvh.stats.references},
           {"bvh_bytes", bvh.bytes()},
           {"bvh_bytes_per_triangle", double(bvh.bytes()) / double(scene.triangleCount())},
           {"bvh_wide_nodes", bvh.stats.wideNodes},
