@@ -19,7 +19,7 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
                          __global const int* triangle_material, __global const GpuMaterial* materials,
                          __global const float* light_cdf, __global const int* light_triangle,
                          __global const float* light_pdf_area, __global const float4* normals,
-                         __global const float2* uvs, __global const float4* texels,
+                         __global const float2* uvs, __global const uint* texels,
                          __global const uint4* texture_info, __global const float* env_map,
                          __global float4* pass_buffer,
                          __global float4* aovs FH_PATH_PARAMS) {

@@ -74,7 +74,7 @@ typedef struct {
 FH_INLINE ShadeOutcome shade_paths(RenderParams params, luint p, lmask active, __global const float4* triangles,
                                    __global const int* triangle_material, __global const GpuMaterial* materials,
                                    __global const float* light_pdf_area, __global const float4* normals,
-                                   __global const float2* uvs, __global const float4* texels,
+                                   __global const float2* uvs, __global const uint* texels,
                                    __global const uint4* texture_info, __global const float* env_map,
                                    __global float4* aovs FH_PATH_PARAMS) {
   ShadeOutcome o;
@@ -197,7 +197,7 @@ __kernel void shade(RenderParams params, __global const uint* ray_queue, __globa
                     __global uint* finished_queue, volatile __global WavefrontCounters* counters, uint parity,
                     __global const float4* triangles, __global const int* triangle_material,
                     __global const GpuMaterial* materials, __global const float* light_pdf_area,
-                    __global const float4* normals, __global const float2* uvs, __global const float4* texels,
+                    __global const float4* normals, __global const float2* uvs, __global const uint* texels,
                     __global const uint4* texture_info, __global const float* env_map,
                     __global float4* aovs FH_PATH_PARAMS FH_SHADOW_PARAMS) {
   volatile __local uint scratch[2 * 3];

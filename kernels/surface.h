@@ -7,9 +7,21 @@
 
 #include "ray.h"
 
-// Texture i covers texels[offset .. offset + width * height) (float4, linear RGB, rows
-// from the top); texture_info[i] = (offset, width, height, unused). One lookup.
-FH_INLINE float3 texture_texel(__global const float4* texels, __global const uint4* texture_info, int texture,
+// Texture i: texture_info[i] = (offset, width, height, format) into texels, 32-bit words,
+// rows from the top (host/render/device_scene.h). Format 1: an 8-bit sRGB image, a word per
+// texel (R | G << 8 | B << 16), each code decoded by the table of linear values (float
+// bits) in texels[0 .. 256). Format 0: linear float RGBA, four words per texel.
+FH_INLINE float3 texel_at(__global const uint* texels, uint4 info, int index) {
+  if (info.w == 1u) {
+    const uint code = texels[info.x + (uint)index];
+    return (float3)(as_float(texels[code & 255u]), as_float(texels[(code >> 8) & 255u]),
+                    as_float(texels[(code >> 16) & 255u]));
+  }
+  return vload3(0, (__global const float*)(texels + info.x + 4u * (uint)index));
+}
+
+// One bilinear lookup, wrapping.
+FH_INLINE float3 texture_texel(__global const uint* texels, __global const uint4* texture_info, int texture,
                                float2 uv) {
   const uint4 info = texture_info[texture];
   const float w = (float)info.y, h = (float)info.z;
@@ -24,14 +36,14 @@ FH_INLINE float3 texture_texel(__global const float4* texels, __global const uin
   const int xa = clamp((int)fx + (fx < 0.0f ? iw : 0), 0, iw - 1);
   const int ya = clamp((int)fy + (fy < 0.0f ? ih : 0), 0, ih - 1);
   const int xb = xa + 1 == iw ? 0 : xa + 1, yb = ya + 1 == ih ? 0 : ya + 1;
-  __global const float4* t = texels + info.x;
-  const float4 top = mix(t[ya * iw + xa], t[ya * iw + xb], tx), bottom = mix(t[yb * iw + xa], t[yb * iw + xb], tx);
-  return mix(top, bottom, ty).xyz;
+  const float3 top = mix(texel_at(texels, info, ya * iw + xa), texel_at(texels, info, ya * iw + xb), tx);
+  const float3 bottom = mix(texel_at(texels, info, yb * iw + xa), texel_at(texels, info, yb * iw + xb), tx);
+  return mix(top, bottom, ty);
 }
 
 // The textured albedo in the lanes with a texture (texture >= 0), `albedo` in the others.
 // Texture fetches are gathers whatever the lanes, so each lane looks up its own.
-FH_INLINE lvec3 texture_lookup(__global const float4* texels, __global const uint4* texture_info, lint texture,
+FH_INLINE lvec3 texture_lookup(__global const uint* texels, __global const uint4* texture_info, lint texture,
                                lvec2 uv, lvec3 albedo) {
   FH_FOR_LANES(l) {
     if (LANE(texture, l) < 0) continue;

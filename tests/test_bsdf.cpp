@@ -306,13 +306,15 @@ TEST(WhiteFurnace, LosslessObjectsVanishInAUniformEnclosure) {
 // A textured plane under a constant environment: L = rho(uv) * L_env, with rho read from
 // an 8-bit sRGB image (decoded to linear), and v pointing up the image.
 // texture_lookup against the analytic bilinear interpolation of a periodic ramp: texel
-// column x holds red = x, row y green = y, so between texel centres red and green are
+// column x holds red = f(x), row y green = f(y), so between texel centres red and green are
 // linear in u and v, and across the seam at u, v = 0 and 1 they wrap from the last texel to
 // the first. A nearest-texel lookup (issue 17: it passed the test below, which reads texels
-// far from any boundary) is off by up to half a step.
+// far from any boundary) is off by up to half a step. Both texel formats: linear floats
+// (f(x) = x), and 8-bit sRGB codes decoded through the table (f(x) = the linear value of
+// code 50 x), which a lookup that skipped or misindexed the table would miss.
 TEST(Textures, LookupIsBilinearAndWrapsAtTheSeams) {
   const char* kernel = R"CL(
-__kernel void lookup(__global const float4* texels, __global const uint4* info, __global const float2* uv,
+__kernel void lookup(__global const uint* texels, __global const uint4* info, __global const float2* uv,
                      __global float4* out) {
   const uint i = get_global_id(0);
   out[i] = (float4)(texture_texel(texels, info, 0, uv[i]), 0.0f);
@@ -322,10 +324,12 @@ __kernel void lookup(__global const float4* texels, __global const uint4* info, 
   const cl::Program program =
       buildProgramFromSource(dc.context, dc.info.device, assembleKernelSources({"surface.h"}) + kernel, "");
   const int w = 5, h = 4;
-  std::vector<float> texels;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) texels.insert(texels.end(), {float(x), float(y), 0.f, 1.f});
-  const std::vector<uint32_t> info = {0, uint32_t(w), uint32_t(h), 0};
+  const std::vector<uint32_t> table = srgbDecodeTable();
+  auto decoded = [&](int code) {
+    float v;
+    std::memcpy(&v, &table[size_t(code)], 4);
+    return double(v);
+  };
   std::vector<float> uv;
   for (int i = 0; i <= 40; ++i)
     for (int j = 0; j <= 40; ++j) uv.insert(uv.end(), {-0.02f + 1.04f * float(i) / 40.f, -0.02f + 1.04f * float(j) / 40.f});
@@ -333,25 +337,43 @@ __kernel void lookup(__global const float4* texels, __global const uint4* info, 
   auto buffer = [&](size_t bytes, const void* data) {
     return allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, bytes, "test", data);
   };
-  cl::Buffer texelBuffer = buffer(texels.size() * 4, texels.data()), infoBuffer = buffer(16, info.data()),
-             uvBuffer = buffer(uv.size() * 4, uv.data()), out = buffer(n * 16, nullptr);
-  cl::Kernel k = createKernel(program, "lookup");
-  setKernelArgs(k, texelBuffer, infoBuffer, uvBuffer, out);
-  FH_CL(dc.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n)));
-  std::vector<float> result(n * 4);
-  FH_CL(dc.queue.enqueueReadBuffer(out, CL_TRUE, 0, result.size() * 4, result.data()));
-  // The periodic ramp c(k) = k mod size, interpolated linearly at texel coordinate x
-  // (texel centres at integers).
-  auto ramp = [](double x, int size) {
-    const double f = std::floor(x);
-    const int k0 = ((int(f) % size) + size) % size, k1 = (k0 + 1) % size;
-    return double(k0) * (1.0 - (x - f)) + double(k1) * (x - f);
-  };
-  for (size_t i = 0; i < n; ++i) {
-    const double u = uv[2 * i] - std::floor(uv[2 * i]), v = uv[2 * i + 1] - std::floor(uv[2 * i + 1]);
-    const double red = ramp(u * w - 0.5, w), green = ramp((1.0 - v) * h - 0.5, h);  // rows run down the image
-    EXPECT_NEAR(result[4 * i], red, 1e-4) << "u " << uv[2 * i];
-    EXPECT_NEAR(result[4 * i + 1], green, 1e-4) << "v " << uv[2 * i + 1];
+  for (const auto format : {TextureData::kLinearFloat, TextureData::kSrgb8}) {
+    const bool srgb8 = format == TextureData::kSrgb8;
+    auto value = [&](int k) { return srgb8 ? decoded(50 * k) : double(k); };
+    std::vector<uint32_t> words = table;  // the table always leads the buffer
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        if (srgb8) {
+          words.push_back(uint32_t(50 * x) | uint32_t(50 * y) << 8);
+          continue;
+        }
+        for (float c : {float(x), float(y), 0.f, 1.f}) {
+          uint32_t bits;
+          std::memcpy(&bits, &c, 4);
+          words.push_back(bits);
+        }
+      }
+    const std::vector<uint32_t> info = {uint32_t(table.size()), uint32_t(w), uint32_t(h), uint32_t(format)};
+    cl::Buffer texelBuffer = buffer(words.size() * 4, words.data()), infoBuffer = buffer(16, info.data()),
+               uvBuffer = buffer(uv.size() * 4, uv.data()), out = buffer(n * 16, nullptr);
+    cl::Kernel k = createKernel(program, "lookup");
+    setKernelArgs(k, texelBuffer, infoBuffer, uvBuffer, out);
+    FH_CL(dc.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n)));
+    std::vector<float> result(n * 4);
+    FH_CL(dc.queue.enqueueReadBuffer(out, CL_TRUE, 0, result.size() * 4, result.data()));
+    // The periodic ramp f(k mod size), interpolated linearly at texel coordinate x (texel
+    // centres at integers).
+    auto ramp = [&](double x, int size) {
+      const double f = std::floor(x);
+      const int k0 = ((int(f) % size) + size) % size, k1 = (k0 + 1) % size;
+      return value(k0) * (1.0 - (x - f)) + value(k1) * (x - f);
+    };
+    for (size_t i = 0; i < n; ++i) {
+      const double u = uv[2 * i] - std::floor(uv[2 * i]), v = uv[2 * i + 1] - std::floor(uv[2 * i + 1]);
+      const double red = ramp(u * w - 0.5, w), green = ramp((1.0 - v) * h - 0.5, h);  // rows run down the image
+      EXPECT_NEAR(result[4 * i], red, 1e-4) << (srgb8 ? "sRGB8 " : "float ") << "u " << uv[2 * i];
+      EXPECT_NEAR(result[4 * i + 1], green, 1e-4) << (srgb8 ? "sRGB8 " : "float ") << "v " << uv[2 * i + 1];
+    }
   }
 }
 

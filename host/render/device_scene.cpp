@@ -114,6 +114,36 @@ SceneFeatures sceneFeatures(const Scene& scene) {
   return f;
 }
 
+namespace {
+
+uint32_t floatBits(float v) {
+  uint32_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  return bits;
+}
+
+}  // namespace
+
+#ifdef FREDHOLM_HAVE_OIIO
+std::vector<uint32_t> srgbDecodeTable() {
+  // Converted by OpenImageIO as it converts an 8-bit image read as float, so a texel
+  // decodes to the bits it had when textures were stored as floats.
+  unsigned char codes[256];
+  float encoded[256];
+  for (int c = 0; c < 256; ++c) codes[c] = static_cast<unsigned char>(c);
+  OIIO::convert_pixel_values(OIIO::TypeDesc::UINT8, codes, OIIO::TypeDesc::FLOAT, encoded, 256);
+  std::vector<uint32_t> table(256);
+  for (int c = 0; c < 256; ++c) table[size_t(c)] = floatBits(srgbToLinear(encoded[c]));
+  return table;
+}
+#else
+std::vector<uint32_t> srgbDecodeTable() {
+  std::vector<uint32_t> table(256);
+  for (int c = 0; c < 256; ++c) table[size_t(c)] = floatBits(srgbToLinear(float(c) / 255.f));
+  return table;
+}
+#endif
+
 TextureData loadTexture(const std::string& path) {
 #ifndef FREDHOLM_HAVE_OIIO
   throw Error(path + ": cannot read texture (this build has no OpenImageIO)");
@@ -122,21 +152,34 @@ TextureData loadTexture(const std::string& path) {
   if (!in) throw Error(path + ": cannot read texture (" + OIIO::geterror() + ")");
   const OIIO::ImageSpec& spec = in->spec();
   const int channels = spec.nchannels;
-  std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(channels));
-  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data()))
-    throw Error(path + ": cannot read texture (" + in->geterror() + ")");
-  // 8- and 16-bit images hold sRGB-encoded colour; float images are linear already.
-  const bool srgb = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
+  const size_t texels = size_t(spec.width) * size_t(spec.height);
+  auto channel = [&](size_t p, int c) { return p * size_t(channels) + size_t(channels >= 3 ? c : 0); };
   TextureData t;
   t.width = spec.width;
   t.height = spec.height;
-  t.texels.resize(size_t(t.width) * size_t(t.height) * 4);
-  for (size_t p = 0; p < size_t(t.width) * size_t(t.height); ++p) {
+  if (spec.format.basetype == OIIO::TypeDesc::UINT8) {
+    std::vector<unsigned char> pixels(texels * size_t(channels));
+    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, pixels.data()))
+      throw Error(path + ": cannot read texture (" + in->geterror() + ")");
+    t.format = TextureData::kSrgb8;
+    t.words.resize(texels);
+    for (size_t p = 0; p < texels; ++p)
+      t.words[p] = uint32_t(pixels[channel(p, 0)]) | uint32_t(pixels[channel(p, 1)]) << 8 |
+                   uint32_t(pixels[channel(p, 2)]) << 16;
+    return t;
+  }
+  std::vector<float> pixels(texels * size_t(channels));
+  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data()))
+    throw Error(path + ": cannot read texture (" + in->geterror() + ")");
+  // 16-bit images hold sRGB-encoded colour too; float images are linear already.
+  const bool srgb = spec.format.basetype == OIIO::TypeDesc::UINT16;
+  t.words.resize(4 * texels);
+  for (size_t p = 0; p < texels; ++p) {
     for (int c = 0; c < 3; ++c) {
-      const float v = pixels[p * size_t(channels) + size_t(channels >= 3 ? c : 0)];
-      t.texels[4 * p + size_t(c)] = srgb ? srgbToLinear(v) : v;
+      const float v = pixels[channel(p, c)];
+      t.words[4 * p + size_t(c)] = floatBits(srgb ? srgbToLinear(v) : v);
     }
-    t.texels[4 * p + 3] = 1.f;
+    t.words[4 * p + 3] = floatBits(1.f);
   }
   return t;
 #endif
@@ -179,9 +222,9 @@ DeviceScene::DeviceScene(DeviceContext& dc, const Scene& scene, const Bvh& hostB
   normals = upload(dc, cornerNormals, "shading normals");
   uvs = upload(dc, cornerUVs, "texture coordinates");
 
-  std::vector<float> allTexels;
-  std::vector<uint32_t> info;
+  std::vector<uint32_t> allTexels, info;
   if (f.textures) {
+    allTexels = srgbDecodeTable();
     for (size_t index = 0; index < scene.textures.size(); ++index) {
       const Texture& tex = scene.textures[index];
       TextureData t;
@@ -193,10 +236,11 @@ DeviceScene::DeviceScene(DeviceContext& dc, const Scene& scene, const Bvh& hostB
           if (m.kdTexture == int(index)) users += (users.empty() ? "material '" : ", '") + m.name + "'";
         warnings.push_back(users + ": " + e.what() + "; using a grey texel");
         t.width = t.height = 1;
-        t.texels = {0.5f, 0.5f, 0.5f, 1.f};
+        t.format = TextureData::kLinearFloat;
+        t.words = {floatBits(0.5f), floatBits(0.5f), floatBits(0.5f), floatBits(1.f)};
       }
-      info.insert(info.end(), {uint32_t(allTexels.size() / 4), uint32_t(t.width), uint32_t(t.height), 0u});
-      allTexels.insert(allTexels.end(), t.texels.begin(), t.texels.end());
+      info.insert(info.end(), {uint32_t(allTexels.size()), uint32_t(t.width), uint32_t(t.height), uint32_t(t.format)});
+      allTexels.insert(allTexels.end(), t.words.begin(), t.words.end());
     }
   }
   texels = upload(dc, allTexels, "textures");

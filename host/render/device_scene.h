@@ -44,11 +44,20 @@ struct SceneFeatures {
 
 SceneFeatures sceneFeatures(const Scene& scene);
 
-// A texture as linear float RGBA texels (rows from the top), 8-bit images decoded from sRGB.
+// A texture as the kernels read it (kernels/surface.h), rows from the top. An 8-bit image
+// keeps its sRGB codes, a 32-bit word per texel (R | G << 8 | B << 16), for the kernels to
+// decode through kSrgbTable: a quarter of the memory, and so of the cache misses, of
+// float texels, with the same values. Other images hold linear float RGBA, a word per
+// channel (the float's bits).
 struct TextureData {
+  enum Format : uint32_t { kLinearFloat = 0, kSrgb8 = 1 };
   int width = 0, height = 0;
-  std::vector<float> texels;
+  Format format = kLinearFloat;
+  std::vector<uint32_t> words;
 };
+// The linear value of each 8-bit sRGB code, as float bits: the first 256 words of the
+// kernels' texel buffer.
+std::vector<uint32_t> srgbDecodeTable();
 // Reads a map_Kd image through OpenImageIO (1, 3 or 4 channels); throws fh::Error.
 TextureData loadTexture(const std::string& path);
 
