@@ -11,48 +11,65 @@
 // rows from the top (host/render/device_scene.h). Format 1: an 8-bit sRGB image, a word per
 // texel (R | G << 8 | B << 16), each code decoded by the table of linear values (float
 // bits) in texels[0 .. 256). Format 0: linear float RGBA, four words per texel.
-FH_INLINE float3 texel_at(__global const uint* texels, uint4 info, int index) {
-  if (info.w == 1u) {
-    const uint code = texels[info.x + (uint)index];
+FH_INLINE float3 texel_at(__global const uint* texels, uint offset, uint format, int index) {
+  if (format == 1u) {
+    const uint code = texels[offset + (uint)index];
     return (float3)(as_float(texels[code & 255u]), as_float(texels[(code >> 8) & 255u]),
                     as_float(texels[(code >> 16) & 255u]));
   }
-  return vload3(0, (__global const float*)(texels + info.x + 4u * (uint)index));
+  return vload3(0, (__global const float*)(texels + offset + 4u * (uint)index));
 }
 
-// One bilinear lookup, wrapping.
-FH_INLINE float3 texture_texel(__global const uint* texels, __global const uint4* texture_info, int texture,
-                               float2 uv) {
-  const uint4 info = texture_info[texture];
-  const float w = (float)info.y, h = (float)info.z;
+// The lanes' texels at (column, row), each from its lane's texture.
+FH_INLINE lvec3 gather_texels(__global const uint* texels, luint offset, luint format, lint column, lint row,
+                              lint width) {
+  const lint index = row * width + column;
+  lvec3 c;
+  FH_FOR_LANES(l) {
+    const float3 t = texel_at(texels, LANE(offset, l), LANE(format, l), LANE(index, l));
+    LANE(c.x, l) = t.x;
+    LANE(c.y, l) = t.y;
+    LANE(c.z, l) = t.z;
+  }
+  return c;
+}
+
+FH_INLINE lvec3 v3_mix(lvec3 a, lvec3 b, lfloat t) { return v3(mix(a.x, b.x, t), mix(a.y, b.y, t), mix(a.z, b.z, t)); }
+
+// The textured albedo in the lanes with a texture (texture >= 0), `albedo` in the others:
+// bilinear, wrapping. The coordinates are computed for all lanes at once and the texel
+// loads of all lanes issued together, so their cache misses overlap.
+FH_INLINE lvec3 texture_lookup(__global const uint* texels, __global const uint4* texture_info, lint texture,
+                               lvec2 uv, lvec3 albedo) {
+  const lmask textured = texture >= 0;
+  if (!lanes_any(textured)) return albedo;
+  // Lanes without a texture read texture 0's first texel and are dropped at the end.
+  luint offset, format;
+  lint iw, ih;
+  FH_FOR_LANES(l) {
+    const uint4 info = texture_info[LANE(textured, l) ? LANE(texture, l) : 0];
+    LANE(offset, l) = info.x;
+    LANE(iw, l) = (int)info.y;
+    LANE(ih, l) = (int)info.z;
+    LANE(format, l) = info.w;
+  }
+  const lfloat w = lconvert_float(iw), h = lconvert_float(ih);
+  const lfloat u = select((lfloat)(0.0f), uv.x, textured), v = select((lfloat)(0.0f), uv.y, textured);
   // OBJ's v runs up the image; texel rows run down it.
-  const float x = (uv.x - floor(uv.x)) * w - 0.5f, y = (1.0f - (uv.y - floor(uv.y))) * h - 0.5f;
-  const float fx = floor(x), fy = floor(y);
-  const float tx = x - fx, ty = y - fy;
-  const int iw = (int)info.y, ih = (int)info.z;
+  const lfloat x = (u - floor(u)) * w - 0.5f, y = (1.0f - (v - floor(v))) * h - 0.5f;
+  const lfloat fx = floor(x), fy = floor(y);
+  const lfloat tx = x - fx, ty = y - fy;
   // The wrapped texel columns and rows without integer divisions (which vector units lack):
   // x and y lie in [-0.5, size - 0.5], so fx and fy lie in [-1, size - 1], and only -1
   // wraps. The clamp keeps non-finite coordinates inside the texture.
-  const int xa = clamp((int)fx + (fx < 0.0f ? iw : 0), 0, iw - 1);
-  const int ya = clamp((int)fy + (fy < 0.0f ? ih : 0), 0, ih - 1);
-  const int xb = xa + 1 == iw ? 0 : xa + 1, yb = ya + 1 == ih ? 0 : ya + 1;
-  const float3 top = mix(texel_at(texels, info, ya * iw + xa), texel_at(texels, info, ya * iw + xb), tx);
-  const float3 bottom = mix(texel_at(texels, info, yb * iw + xa), texel_at(texels, info, yb * iw + xb), tx);
-  return mix(top, bottom, ty);
-}
-
-// The textured albedo in the lanes with a texture (texture >= 0), `albedo` in the others.
-// Texture fetches are gathers whatever the lanes, so each lane looks up its own.
-FH_INLINE lvec3 texture_lookup(__global const uint* texels, __global const uint4* texture_info, lint texture,
-                               lvec2 uv, lvec3 albedo) {
-  FH_FOR_LANES(l) {
-    if (LANE(texture, l) < 0) continue;
-    const float3 c = texture_texel(texels, texture_info, LANE(texture, l), (float2)(LANE(uv.x, l), LANE(uv.y, l)));
-    LANE(albedo.x, l) = c.x;
-    LANE(albedo.y, l) = c.y;
-    LANE(albedo.z, l) = c.z;
-  }
-  return albedo;
+  const lint xa = clamp(lconvert_int(fx) + select((lint)(0), iw, fx < 0.0f), (lint)(0), iw - 1);
+  const lint ya = clamp(lconvert_int(fy) + select((lint)(0), ih, fy < 0.0f), (lint)(0), ih - 1);
+  const lint xb = select(xa + 1, (lint)(0), xa + 1 == iw), yb = select(ya + 1, (lint)(0), ya + 1 == ih);
+  const lvec3 top = v3_mix(gather_texels(texels, offset, format, xa, ya, iw),
+                           gather_texels(texels, offset, format, xb, ya, iw), tx);
+  const lvec3 bottom = v3_mix(gather_texels(texels, offset, format, xa, yb, iw),
+                              gather_texels(texels, offset, format, xb, yb, iw), tx);
+  return v3_select(textured, v3_mix(top, bottom, ty), albedo);
 }
 
 // The shading normal at barycentrics (b1, b2), turned to the side of `ng` (the geometric

@@ -317,7 +317,8 @@ TEST(Textures, LookupIsBilinearAndWrapsAtTheSeams) {
 __kernel void lookup(__global const uint* texels, __global const uint4* info, __global const float2* uv,
                      __global float4* out) {
   const uint i = get_global_id(0);
-  out[i] = (float4)(texture_texel(texels, info, 0, uv[i]), 0.0f);
+  const lvec3 c = texture_lookup(texels, info, 0, lv2(uv[i].x, uv[i].y), v3_splat(-1.0f));
+  out[i] = (float4)(c.x, c.y, c.z, 0.0f);
 }
 )CL";
   DeviceContext dc(selectDevices(listDevices(), "").front());
