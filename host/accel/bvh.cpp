@@ -322,7 +322,8 @@ class BinaryBuilder {
     if (room > 0 && s.axis >= 0 && Box::overlap(s.left, s.right).area() > kOverlapToTrySpatial * rootArea_) {
       const Split spatial = spatialSplit(refs, box, area);
       // Only within the budget: a spatial split adds at most the references it cuts.
-      if (spatial.cost < s.cost * (1.f - kSpatialSplitGain) && spatial.leftCount + spatial.rightCount - count <= room) s = spatial;
+      const size_t added = spatial.leftCount + spatial.rightCount - count;
+      if (spatial.cost < s.cost * (1.f - kSpatialSplitGain) && added <= room) s = spatial;
     }
     if (s.axis >= 0 && count <= kMaxLeaf && kTriangleCost * float(count) <= s.cost) return makeLeaf(node, refs);
 
@@ -542,8 +543,8 @@ Bvh buildBvh(const Scene& scene, BvhOptions options) {
   int parallelDepth = 0;
   while (threads > 1 && (1u << parallelDepth) < 4 * threads) ++parallelDepth;
   const size_t room = size_t(double(options.spatialSplitBudget) * double(refs.size()));
-  const BinaryTree binary =
-      BinaryBuilder(corners.data(), std::max(sceneBox.area(), 1e-30f), parallelDepth).build({refs.data(), refs.data() + refs.size()}, room);
+  BinaryBuilder builder(corners.data(), std::max(sceneBox.area(), 1e-30f), parallelDepth);
+  const BinaryTree binary = builder.build({refs.data(), refs.data() + refs.size()}, room);
   bvh.stats.binaryNodes = binary.nodes.size();
   bvh.stats.references = binary.leafTriangles.size();
   bvh.stats.sahCost = sahCost(binary.nodes);
