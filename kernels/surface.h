@@ -8,11 +8,11 @@
 #include "ray.h"
 
 // Texture i: texture_info[i] = (offset, width, height, format) into texels, 32-bit words,
-// rows from the top (host/render/device_scene.h). Format 1: an 8-bit sRGB image, a word per
-// texel (R | G << 8 | B << 16), each code decoded by the table of linear values (float
-// bits) in texels[0 .. 256). Format 0: linear float RGBA, four words per texel.
+// rows from the top (host/render/device_scene.h). FH_TEXELS_SRGB8: a word per texel
+// (R | G << 8 | B << 16), each code decoded by the table of linear values (float bits) in
+// texels[0 .. 256). FH_TEXELS_LINEAR_FLOAT: linear float RGBA, four words per texel.
 FH_INLINE float3 texel_at(__global const uint* texels, uint offset, uint format, int index) {
-  if (format == 1u) {
+  if (format == FH_TEXELS_SRGB8) {
     const uint code = texels[offset + (uint)index];
     return (float3)(as_float(texels[code & 255u]), as_float(texels[(code >> 8) & 255u]),
                     as_float(texels[(code >> 16) & 255u]));

@@ -95,6 +95,11 @@ typedef struct {
 #define FH_PASS_ENTRY_INDEX(pass_entry) ((pass_entry) / FH_MAX_PASS_SLOTS)
 #define FH_PASS_ENTRY_SLOT(pass_entry) ((pass_entry) % FH_MAX_PASS_SLOTS)
 
+// Texel formats (texture_info[i].w, kernels/surface.h): linear float RGBA, four 32-bit words
+// per texel; or an 8-bit sRGB image, one word per texel, decoded through a table.
+#define FH_TEXELS_LINEAR_FLOAT 0u
+#define FH_TEXELS_SRGB8 1u
+
 // The shape of a run of passes: each covers `pixels` pixels, those listed from `list` on in
 // the pixel list (every pixel, or an adaptive round's, render/adaptive.h); its first pass is
 // local pass `first_pass` and starts at local sample `first_sample`.

@@ -124,25 +124,21 @@ uint32_t floatBits(float v) {
 
 }  // namespace
 
-#ifdef FREDHOLM_HAVE_OIIO
 std::vector<uint32_t> srgbDecodeTable() {
+  float encoded[256];
+#ifdef FREDHOLM_HAVE_OIIO
   // Converted by OpenImageIO as it converts an 8-bit image read as float, so a texel
   // decodes to the bits it had when textures were stored as floats.
   unsigned char codes[256];
-  float encoded[256];
   for (int c = 0; c < 256; ++c) codes[c] = static_cast<unsigned char>(c);
   OIIO::convert_pixel_values(OIIO::TypeDesc::UINT8, codes, OIIO::TypeDesc::FLOAT, encoded, 256);
+#else
+  for (int c = 0; c < 256; ++c) encoded[c] = float(c) / 255.f;
+#endif
   std::vector<uint32_t> table(256);
   for (int c = 0; c < 256; ++c) table[size_t(c)] = floatBits(srgbToLinear(encoded[c]));
   return table;
 }
-#else
-std::vector<uint32_t> srgbDecodeTable() {
-  std::vector<uint32_t> table(256);
-  for (int c = 0; c < 256; ++c) table[size_t(c)] = floatBits(srgbToLinear(float(c) / 255.f));
-  return table;
-}
-#endif
 
 TextureData loadTexture(const std::string& path) {
 #ifndef FREDHOLM_HAVE_OIIO

@@ -46,11 +46,10 @@ SceneFeatures sceneFeatures(const Scene& scene);
 
 // A texture as the kernels read it (kernels/surface.h), rows from the top. An 8-bit image
 // keeps its sRGB codes, a 32-bit word per texel (R | G << 8 | B << 16), for the kernels to
-// decode through kSrgbTable: a quarter of the memory, and so of the cache misses, of
-// float texels, with the same values. Other images hold linear float RGBA, a word per
-// channel (the float's bits).
+// decode through srgbDecodeTable(): a quarter of the memory of float texels, with the same
+// values. Other images hold linear float RGBA, a word per channel (the float's bits).
 struct TextureData {
-  enum Format : uint32_t { kLinearFloat = 0, kSrgb8 = 1 };
+  enum Format : uint32_t { kLinearFloat = FH_TEXELS_LINEAR_FLOAT, kSrgb8 = FH_TEXELS_SRGB8 };
   int width = 0, height = 0;
   Format format = kLinearFloat;
   std::vector<uint32_t> words;
