@@ -154,9 +154,10 @@ TEST(AdaptiveFilm, TheNoiseEstimateCountsEachPixelsOwnSamples) {
   EXPECT_EQ(film.count(1), 3.0);
   EXPECT_EQ(film.oddSum[kOddSumsPerPixel * 0 + 3], 8.0);
   EXPECT_EQ(film.oddSum[kOddSumsPerPixel * 1 + 3], 1.0);
-  // Per pixel: D^2 nEven nOdd / n^2 over mean^2 + epsilon, D the halves' means' difference.
-  const double mean1 = (0.4 + 0.6 + 0.4) / 3;
-  const double pixel0 = 0.04 * 8 * 8 / 256 / (0.25 + 0.01), pixel1 = 0.04 * 2 * 1 / 9 / (mean1 * mean1 + 0.01);
+  // Per pixel: D^2 nEven nOdd / n^2 over the neighbours' mean^2 + epsilon (here the other
+  // pixel's), D the halves' means' difference.
+  const double mean0 = 0.5, mean1 = (0.4 + 0.6 + 0.4) / 3;
+  const double pixel0 = 0.04 * 8 * 8 / 256 / (mean1 * mean1 + 0.01), pixel1 = 0.04 * 2 * 1 / 9 / (mean0 * mean0 + 0.01);
   EXPECT_NEAR(film.estimatedRelMse(), (pixel0 + pixel1) / 2, 1e-6);
 }
 

@@ -29,30 +29,37 @@ Film renderFilm(const Scene& scene, int width, int height, int spp, double noise
   return fh::render(dc, scene, bvh, scene.camera, s).film;
 }
 
-// Renders to `target`, then checks the film's estimate against the error measured.
-void expectEstimateNearTheTruth(const Scene& scene, int width, int height, int referenceSpp, double target) {
+// Renders to each target, then checks the film's estimate against the error measured.
+void expectEstimateNearTheTruth(const Scene& scene, int width, int height, int referenceSpp,
+                                std::initializer_list<double> targets) {
   // The reference with two replicates too (a target it never reaches), for its own error.
   const Film reference = renderFilm(scene, width, height, referenceSpp, 1e-12, 1000);
-  for (unsigned seed : {1u, 2u}) {
-    const Film film = renderFilm(scene, width, height, referenceSpp, target, seed);
-    const double estimate = film.estimatedRelMse();
-    EXPECT_LE(estimate, target);
-    EXPECT_GE(film.passes(), uint64_t(kNoiseMinPasses));
-    EXPECT_LT(film.passes(), uint64_t(referenceSpp) / 8) << "the reference is too short for this target";
-    const double truth = imageError(film.image(), reference.image()).relMse - reference.estimatedRelMse();
-    EXPECT_GT(truth, estimate / 1.5) << "seed " << seed << ", " << film.passes() << " passes";
-    EXPECT_LT(truth, estimate * 1.5) << "seed " << seed << ", " << film.passes() << " passes";
+  for (double target : targets) {
+    for (unsigned seed : {1u, 2u}) {
+      const Film film = renderFilm(scene, width, height, referenceSpp, target, seed);
+      const double estimate = film.estimatedRelMse();
+      EXPECT_LE(estimate, target);
+      EXPECT_GE(film.passes(), uint64_t(kNoiseMinPasses));
+      EXPECT_LT(film.passes(), uint64_t(referenceSpp) / 8) << "the reference is too short for this target";
+      const double truth = imageError(film.image(), reference.image()).relMse - reference.estimatedRelMse();
+      const std::string where = "target " + std::to_string(target) + ", seed " + std::to_string(seed) + ", " +
+                                std::to_string(film.passes()) + " passes";
+      EXPECT_GT(truth, estimate / 1.5) << where;
+      EXPECT_LT(truth, estimate * 1.5) << where;
+    }
   }
 }
 
 TEST(NoiseTarget, EstimateMatchesTheTruthOnTheCornellBox) {
-  expectEstimateNearTheTruth(loadDefaultScene(), 32, 32, 4096, 3e-3);
+  expectEstimateNearTheTruth(loadDefaultScene(), 32, 32, 4096, {3e-3});
 }
 
 // Near-mirror plates and small bright lights: heavy-tailed samples, the hard case for an
-// error estimate from the samples themselves.
+// error estimate from the samples themselves (at 3e-2 few of the rare bright samples have
+// shown up yet). Large enough that the lights' reflections span a few pixels: where a
+// pixel's neighbours are all unlike it, their mean is a poor stand-in for its value.
 TEST(NoiseTarget, EstimateMatchesTheTruthOnTheVeachPlates) {
-  expectEstimateNearTheTruth(loadScene(test::testScene("veach/veach-plates.obj")), 48, 32, 16384, 1e-2);
+  expectEstimateNearTheTruth(loadScene(test::testScene("veach/veach-plates.obj")), 96, 64, 16384, {3e-2, 1e-2});
 }
 
 // Stopping is decided on merged passes only, so the image for a seed and target is the

@@ -98,7 +98,35 @@ void Film::addPass(uint64_t pass, const std::vector<float>& samples, const std::
   setPassRanges(held_);
 }
 
+namespace {
+
+// The mean of each channel over pixel (x, y)'s neighbours (up to 8, those with samples); the
+// pixel's own where none has any.
+std::array<double, 3> neighbourMean(const Film& film, int x, int y) {
+  std::array<double, 3> total{}, own{};
+  int n = 0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int nx = x + dx, ny = y + dy;
+      if (nx < 0 || ny < 0 || nx >= film.width || ny >= film.height) continue;
+      const size_t q = size_t(ny) * size_t(film.width) + size_t(nx);
+      if (film.count(q) <= 0) continue;
+      std::array<double, 3>& to = dx == 0 && dy == 0 ? own : total;
+      for (size_t c = 0; c < 3; ++c) to[c] += film.sum[4 * q + c] / film.count(q);
+      n += dx != 0 || dy != 0;
+    }
+  if (n == 0) return own;
+  for (double& t : total) t /= n;
+  return total;
+}
+
+}  // namespace
+
 double Film::estimatedRelMse() const {
+  // relMSE divides by the converged value; the pixel's own mean stands in for it badly: a
+  // rare bright sample raises both the pixel's error and its mean, so the two cancel and the
+  // estimate runs low where such samples dominate. The neighbours' means do not depend on
+  // the pixel's samples (bench/RESULTS.md, "--noise").
   double total = 0.0;
   for (size_t p = 0; p < pixels(); ++p) {
     const double n = count(p);
@@ -109,14 +137,14 @@ double Film::estimatedRelMse() const {
     const double nOdd = oddSum.empty() ? 0.0 : oddSum[kOddSumsPerPixel * p + 3], nEven = n - nOdd;
     const bool replicated = nOdd > 0 && nEven > 0;
     const std::array<double, 3> variance = varianceOfMean(p);
+    const std::array<double, 3> converged = neighbourMean(*this, int(p % size_t(width)), int(p / size_t(width)));
     for (size_t c = 0; c < 3; ++c) {
-      const double mean = sum[4 * p + c] / n;
       double error = variance[c];
       if (replicated) {
         const double odd = oddSum[kOddSumsPerPixel * p + c], d = (sum[4 * p + c] - odd) / nEven - odd / nOdd;
         error = d * d * nEven * nOdd / (n * n);
       }
-      total += error / (mean * mean + kRelMseEpsilon);
+      total += error / (converged[c] * converged[c] + kRelMseEpsilon);
     }
   }
   return pixels() ? total / double(3 * pixels()) : 0.0;

@@ -66,7 +66,8 @@ struct Film {
   // The variance of the pixel's mean estimate, per channel (sample variance / count).
   std::array<double, 3> varianceOfMean(size_t pixel) const;
   // The image's expected relMSE against the converged image, estimated from the film alone:
-  // each pixel's expected squared error over its squared mean plus relMSE's epsilon,
+  // each pixel's expected squared error over its neighbours' squared mean (the converged
+  // value, judged apart from the pixel's own samples) plus relMSE's epsilon,
   // averaged like relMSE (image/error_metrics.h). The expected squared error of an unbiased
   // mean is its variance: with two replicates, from the difference of the even and odd
   // passes' means (unbiased, as the two are independent); else the sample variance / count,
