@@ -49,18 +49,13 @@ FH_INLINE lvec3 environment_lookup(RenderParams params, __global const float* en
   return radiance;
 }
 
-// The first entry of cdf[0 .. count-1] above u, and in *fraction where u lies between the
-// entry before it and that one (in [0, 1)).
-FH_INLINE uint environment_search(__global const float* cdf, uint count, float u, float* fraction) {
-  uint lo = 0, hi = count - 1;
-  while (lo < hi) {
-    const uint mid = (lo + hi) / 2;
-    if (cdf[mid] > u) hi = mid;
-    else lo = mid + 1;
-  }
-  const float below = lo > 0 ? cdf[lo - 1] : 0.0f, width = cdf[lo] - below;
-  *fraction = width > 0.0f ? clamp((u - below) / width, 0.0f, 0x1.fffffep-1f) : 0.5f;
-  return lo;
+// Where u lies between the CDF entry before `index` and that one, in [0, 1), for each lane
+// (index from search_cdf over the entries from cdf[first]).
+FH_INLINE lfloat cdf_fraction(__global const float* cdf, luint first, luint index, lfloat u) {
+  const luint before = first + index - min(index, (luint)(1u));  // (first itself for index 0)
+  const lfloat below = select((lfloat)(0.0f), gather_float(cdf, before), index > 0u);
+  const lfloat width = gather_float(cdf, first + index) - below;
+  return select((lfloat)(0.5f), clamp((u - below) / width, 0.0f, 0x1.fffffep-1f), width > 0.0f);
 }
 
 // A direction drawn from the map, the radiance arriving from it and its density per solid
@@ -75,16 +70,12 @@ FH_INLINE EnvironmentSample environment_sample(RenderParams params, __global con
   const uint width = params.env_width, height = params.env_height;
   __global const float* row_cdf = env_map + 4 * width * height;
   __global const float* marginal_cdf = row_cdf + width * height;
-  luint texel;
-  lfloat u, v;
-  FH_FOR_LANES(l) {
-    float row_fraction, column_fraction;
-    const uint row = environment_search(marginal_cdf, height, LANE(u1, l), &row_fraction);
-    const uint column = environment_search(row_cdf + row * width, width, LANE(u2, l), &column_fraction);
-    LANE(texel, l) = row * width + column;
-    LANE(v, l) = ((float)(row) + row_fraction) / (float)(height);
-    LANE(u, l) = ((float)(column) + column_fraction) / (float)(width);
-  }
+  const luint row = search_cdf(marginal_cdf, (luint)(0u), height, u1);
+  const luint row_start = row * width;
+  const luint column = search_cdf(row_cdf, row_start, width, u2);
+  const luint texel = row_start + column;
+  const lfloat v = (lconvert_float(row) + cdf_fraction(marginal_cdf, (luint)(0u), row, u1)) / (float)(height);
+  const lfloat u = (lconvert_float(column) + cdf_fraction(row_cdf, row_start, column, u2)) / (float)(width);
   EnvironmentSample s;
   lfloat density;
   s.radiance = environment_texel(env_map, texel, &density);

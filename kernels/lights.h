@@ -11,19 +11,9 @@
 #include "ray.h"
 #include "sampling.h"
 
-// The first light whose CDF value exceeds u (binary search), for each lane.
+// The first light whose CDF value exceeds u (the last light if none does), for each lane.
 FH_INLINE luint pick_light(__global const float* cdf, uint count, lfloat u) {
-  luint picked;
-  FH_FOR_LANES(l) {
-    uint lo = 0, hi = count - 1;
-    while (lo < hi) {
-      const uint mid = (lo + hi) / 2;
-      if (cdf[mid] > LANE(u, l)) hi = mid;
-      else lo = mid + 1;
-    }
-    LANE(picked, l) = lo;
-  }
-  return picked;
+  return search_cdf(cdf, (luint)(0u), count, u);
 }
 
 // Converts an area density at a point seen at distance^2 `dist2` under cosine `cos_light`

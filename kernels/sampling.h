@@ -60,6 +60,22 @@ FH_INLINE lvec3 sample_cosine_hemisphere(lvec3 n, lfloat u1, lfloat u2) {
   return v3_normalize(v3_add(v3_add(v3_scale(t, d.x), v3_scale(b, d.y)), v3_scale(n, lift)));
 }
 
+// Per lane, the first of the `count` entries of a CDF starting at cdf[first] that exceeds
+// u (the last entry if none does), counted from first. A binary search without branches:
+// every lane takes the same steps, a gather and a select each, so the lanes search side by
+// side instead of one after another, each step a branch that mispredicts half the time.
+// `base` stays at the last entry known <= u (or the first).
+FH_INLINE luint search_cdf(__global const float* cdf, luint first, uint count, lfloat u) {
+  luint base = (luint)(0u);
+  for (uint len = count; len > 1;) {
+    const uint step = len / 2;
+    base = select(base, base + step, gather_float(cdf, first + base + step) <= u);
+    len -= step;
+  }
+  const luint above = select((luint)(0u), (luint)(1u), gather_float(cdf, first + base) <= u);
+  return min(base + above, (luint)(count - 1));
+}
+
 // Barycentrics (b1, b2) of a uniform point on a triangle.
 FH_INLINE lvec2 sample_triangle(lfloat u1, lfloat u2) {
   const lfloat su = sqrt(u1);
