@@ -100,25 +100,52 @@ void Film::addPass(uint64_t pass, const std::vector<float>& samples, const std::
 
 namespace {
 
-// The mean of each channel over pixel (x, y)'s neighbours (up to 8, those with samples); the
-// pixel's own where none has any.
-std::array<double, 3> neighbourMean(const Film& film, int x, int y) {
-  std::array<double, 3> total{}, own{};
-  int n = 0;
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx) {
-      const int nx = x + dx, ny = y + dy;
-      if (nx < 0 || ny < 0 || nx >= film.width || ny >= film.height) continue;
-      const size_t q = size_t(ny) * size_t(film.width) + size_t(nx);
-      if (film.count(q) <= 0) continue;
-      std::array<double, 3>& to = dx == 0 && dy == 0 ? own : total;
-      for (size_t c = 0; c < 3; ++c) to[c] += film.sum[4 * q + c] / film.count(q);
-      n += dx != 0 || dy != 0;
+// Per pixel and channel, the mean of the pixel's neighbours' means (up to 8, those with
+// samples); the pixel's own mean where none has any. Rows are asked for in order from the
+// top; three rows of pixel means are kept, summed down each column, then across: a few
+// additions per pixel, as the estimate is taken after every merged pass.
+class NeighbourMeans {
+ public:
+  explicit NeighbourMeans(const Film& film)
+      : film_(film), width_(size_t(film.width)), own_(3 * width_), column_(width_), means_(3 * width_) {}
+
+  const double* row(size_t y) {
+    if (y == 0) fillOwn(0);
+    if (y + 1 < size_t(film_.height)) fillOwn(y + 1);
+    for (size_t x = 0; x < width_; ++x) {
+      column_[x] = {};
+      for (size_t r = y == 0 ? 0 : y - 1; r <= y + 1 && r < size_t(film_.height); ++r) add(column_[x], own(r)[x]);
     }
-  if (n == 0) return own;
-  for (double& t : total) t /= n;
-  return total;
-}
+    for (size_t x = 0; x < width_; ++x) {
+      Mean block = column_[x];
+      if (x > 0) add(block, column_[x - 1]);
+      if (x + 1 < width_) add(block, column_[x + 1]);
+      const Mean& self = own(y)[x];
+      const double n = block[3] - self[3];
+      for (size_t c = 0; c < 3; ++c) means_[3 * x + c] = n > 0 ? (block[c] - self[c]) / n : self[c];
+    }
+    return means_.data();
+  }
+
+ private:
+  using Mean = std::array<double, 4>;  // rgb, and 1 where the pixel has samples (else all 0)
+  static void add(Mean& to, const Mean& v) {
+    for (size_t k = 0; k < 4; ++k) to[k] += v[k];
+  }
+  Mean* own(size_t y) { return own_.data() + (y % 3) * width_; }
+  void fillOwn(size_t y) {
+    for (size_t x = 0; x < width_; ++x) {
+      const size_t p = y * width_ + x;
+      const double n = film_.count(p);
+      own(y)[x] = n > 0 ? Mean{film_.sum[4 * p] / n, film_.sum[4 * p + 1] / n, film_.sum[4 * p + 2] / n, 1.0} : Mean{};
+    }
+  }
+
+  const Film& film_;
+  size_t width_;
+  std::vector<Mean> own_, column_;
+  std::vector<double> means_;
+};
 
 }  // namespace
 
@@ -127,8 +154,11 @@ double Film::estimatedRelMse() const {
   // rare bright sample raises both the pixel's error and its mean, so the two cancel and the
   // estimate runs low where such samples dominate. The neighbours' means do not depend on
   // the pixel's samples (bench/RESULTS.md, "--noise").
+  NeighbourMeans neighbours(*this);
   double total = 0.0;
+  const double* converged = nullptr;  // the row's, 3 per pixel
   for (size_t p = 0; p < pixels(); ++p) {
+    if (p % size_t(width) == 0) converged = neighbours.row(p / size_t(width));
     const double n = count(p);
     if (n <= 0) continue;
     // The mean of nEven and nOdd samples: its variance is D^2 nEven nOdd / n^2 in
@@ -137,14 +167,14 @@ double Film::estimatedRelMse() const {
     const double nOdd = oddSum.empty() ? 0.0 : oddSum[kOddSumsPerPixel * p + 3], nEven = n - nOdd;
     const bool replicated = nOdd > 0 && nEven > 0;
     const std::array<double, 3> variance = varianceOfMean(p);
-    const std::array<double, 3> converged = neighbourMean(*this, int(p % size_t(width)), int(p / size_t(width)));
     for (size_t c = 0; c < 3; ++c) {
       double error = variance[c];
       if (replicated) {
         const double odd = oddSum[kOddSumsPerPixel * p + c], d = (sum[4 * p + c] - odd) / nEven - odd / nOdd;
         error = d * d * nEven * nOdd / (n * n);
       }
-      total += error / (converged[c] * converged[c] + kRelMseEpsilon);
+      const double value = converged[3 * (p % size_t(width)) + c];
+      total += error / (value * value + kRelMseEpsilon);
     }
   }
   return pixels() ? total / double(3 * pixels()) : 0.0;
