@@ -78,11 +78,25 @@ FH_INLINE RayPrecomp precompute_ray(float3 org, float3 dir) {
   return r;
 }
 
+// 1 + 2^-20: widens the division-free interval test below so that it never rejects a lane
+// whose quotient (the t a hit keeps) equals the current hit's t: the products round on
+// their own, by a few ulps at most.
+#define FH_T_WIDEN 1.00000095367f
+
+// Whether a candidate at distance t with BVH-order index id beats the current hit (t_max,
+// best; best < 0: none yet). Ties in t go to the lower index, so the closest hit is the
+// same whatever order the leaves are visited in (single rays and packets alike); with no
+// hit yet, t_max is the ray's own end, which is excluded.
+FH_INLINE int8 closer_hit8(float8 t, int8 id, float8 t_max, int8 best) {
+  return (t < t_max) | ((t == t_max) & (id < best) & (id >= (int8)(0)));
+}
+
 // The watertight test on the eight triangles of a leaf at once. Returns the lane of the
-// closest hit in [t_min, *t_max) (updating *t_max and the barycentrics b1, b2 of v1 and
-// v2), or -1. An any-hit query takes the lowest lane hit and updates nothing.
+// closest hit in [t_min, *t_max) that beats the current one (`best`, see closer_hit8),
+// updating *t_max and the barycentrics b1, b2 of v1 and v2, or -1. An any-hit query takes
+// the lowest lane hit and updates nothing.
 FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8* block, float t_min, float* t_max,
-                              float* b1, float* b2, bool any_hit) {
+                              int best, float* b1, float* b2, bool any_hit) {
   __global const float* v0 = block->v[0][0];
   __global const float* v1 = block->v[1][0];
   __global const float* v2 = block->v[2][0];
@@ -101,28 +115,35 @@ FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8
   // Compare t against the interval without dividing: flip by det's sign.
   const float8 abs_det = fabs(det);
   const float8 ts = select(t_scaled, -t_scaled, det < zero);
-  const int8 maybe = ~outside & (det != zero) & (ts >= t_min * abs_det) & (ts < *t_max * abs_det);
+  const int8 maybe =
+      ~outside & (det != zero) & (ts >= t_min * abs_det) & (ts <= (*t_max * abs_det) * FH_T_WIDEN);
   if (!any(maybe)) return -1;
   // The products above round differently from the quotient below: a lane can pass them
   // and still have t >= t_max (a triangle at the current hit's distance, duplicated or
   // across a shared edge). Accept only on the quotient, the value the hit keeps.
   const float8 quotient = t_scaled / det;
-  const int8 valid = maybe & (quotient >= (float8)(t_min)) & (quotient < (float8)(*t_max));
+  const int8 ids = vload8(0, block->id);
+  const int8 valid = maybe & (quotient >= (float8)(t_min)) & closer_hit8(quotient, ids, (float8)(*t_max), (int8)(best));
   if (!any(valid)) return -1;
   if (any_hit) return lowest_bit(lane_bits(valid));
   const float8 t = select((float8)(INFINITY), quotient, valid);
-  // The nearest lane, the lowest of equals: a min over the lanes, then the first lane at it.
+  // The nearest lane, the lowest index of equals: a min over the lanes, then a min of the
+  // indices at it.
   const float4 m4 = fmin(t.lo, t.hi);
   const float2 m2 = fmin(m4.lo, m4.hi);
   const float nearest = fmin(m2.x, m2.y);
-  const int best = lowest_bit(lane_bits(t == (float8)(nearest)));
+  const int8 at_nearest = valid & (t == (float8)(nearest));
+  const int8 id_at = select((int8)(INT_MAX), ids, at_nearest);
+  const int4 i4 = min(id_at.lo, id_at.hi);
+  const int2 i2 = min(i4.lo, i4.hi);
+  const int lowest = lowest_bit(lane_bits(at_nearest & (ids == (int8)(min(i2.x, i2.y)))));
   *t_max = nearest;
   // Divided in all lanes at once and picked out in registers (a store and reload per value
   // stalled here); the unpicked lanes' quotients, infinite or not, are dropped.
-  const int8 picked = (int8)(best) == (int8)(0, 1, 2, 3, 4, 5, 6, 7);
+  const int8 picked = (int8)(lowest) == (int8)(0, 1, 2, 3, 4, 5, 6, 7);
   *b1 = lane_value(v / det, picked);
   *b2 = lane_value(w / det, picked);
-  return best;
+  return lowest;
 }
 
 // 1 + 2 gamma(3): widens the far slab distance so rounding never culls a box that the
@@ -221,17 +242,18 @@ FH_INLINE TraceHit trace_ray(__global const Bvh8Node* nodes, __global const Tria
       if (ref != 0) continue;
     } else {
       __global const TriangleBlock8* block = blocks + ~ref;
-      const int lane = intersect_block(&r, block, t_min, &hit.t, &hit.b1, &hit.b2, any_hit);
+      const int lane = intersect_block(&r, block, t_min, &hit.t, hit.triangle, &hit.b1, &hit.b2, any_hit);
       if (lane >= 0) {
         hit.triangle = block->id[lane];
         if (any_hit) return hit;
       }
     }
-    // Pop the nearest pending child that may still hold a closer hit.
+    // Pop the nearest pending child that may still hold a closer hit (or one as close with
+    // a lower index: the bound is widened as the box test widens its far distance).
     ref = 0;
     while (sp > 0) {
       --sp;
-      if (stack_t[sp] <= hit.t) {
+      if (stack_t[sp] <= hit.t * FH_SLAB_WIDEN) {
         ref = stack_node[sp];
         break;
       }

@@ -1,6 +1,8 @@
 // Ray casting over arrays of rays stored as float4 pairs (origin.xyz + tmin, direction.xyz +
 // tmax): closest hit and any hit, for fredholm bench and the tests (accel/ray_caster.cpp).
-#include "intersect.h"
+// The *_packets kernels trace eight consecutive rays per work-item together, for coherent
+// batches; they find the same hits.
+#include "intersect_packet.h"
 
 // hits[i]: the closest hit as stored_hit packs it (intersect.h).
 __kernel void intersect_closest(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
@@ -20,4 +22,44 @@ __kernel void intersect_any(__global const Bvh8Node* nodes, __global const Trian
   if (i >= ray_count) return;
   const float4 o = ray_org[i], d = ray_dir[i];
   occluded[i] = trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w, true).triangle >= 0;
+}
+
+// Rays [8 i, 8 i + 8) of the batch as a packet, or one by one where they do not share the
+// watertight test's axis order.
+FH_INLINE int trace_packet_of(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
+                              __global const float4* ray_org, __global const float4* ray_dir, uint ray_count,
+                              bool any_hit, TraceHit* hit) {
+  const uint first = get_global_id(0) * FH_PACKET;
+  if (first >= ray_count) return 0;
+  const int count = (int)min(ray_count - first, (uint)FH_PACKET);
+  float3 org[FH_PACKET], dir[FH_PACKET];
+  float t_min[FH_PACKET], t_max[FH_PACKET];
+  for (int l = 0; l < count; ++l) {
+    const float4 o = ray_org[first + l], d = ray_dir[first + l];
+    org[l] = o.xyz;
+    dir[l] = d.xyz;
+    t_min[l] = o.w;
+    t_max[l] = d.w;
+  }
+  if (!trace_packet(nodes, blocks, org, dir, t_min, t_max, count, any_hit, hit))
+    for (int l = 0; l < count; ++l) hit[l] = trace_ray(nodes, blocks, org[l], dir[l], t_min[l], t_max[l], any_hit);
+  return count;
+}
+
+// As intersect_closest, eight rays per work-item.
+__kernel void intersect_closest_packets(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
+                                        __global const float4* ray_org, __global const float4* ray_dir,
+                                        __global float4* hits, uint ray_count) {
+  TraceHit hit[FH_PACKET];
+  const int count = trace_packet_of(nodes, blocks, ray_org, ray_dir, ray_count, false, hit);
+  for (int l = 0; l < count; ++l) hits[get_global_id(0) * FH_PACKET + l] = stored_hit(hit[l]);
+}
+
+// As intersect_any, eight rays per work-item.
+__kernel void intersect_any_packets(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
+                                    __global const float4* ray_org, __global const float4* ray_dir,
+                                    __global int* occluded, uint ray_count) {
+  TraceHit hit[FH_PACKET];
+  const int count = trace_packet_of(nodes, blocks, ray_org, ray_dir, ray_count, true, hit);
+  for (int l = 0; l < count; ++l) occluded[get_global_id(0) * FH_PACKET + l] = hit[l].triangle >= 0;
 }

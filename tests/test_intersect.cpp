@@ -126,6 +126,8 @@ class RayCasting {
     std::vector<int> occluded(q.count);
     FH_CL(dc.queue.enqueueReadBuffer(occludedBuffer, CL_TRUE, 0, q.count * 4ull, occluded.data()));
 
+    expectPacketsMatchSingleRays(rays, hits, occluded, kind);
+
     const size_t half = rays.size() / 2;
     auto second = std::async(std::launch::async, checkRays, std::cref(scene), std::cref(bvh), std::cref(rays),
                              std::cref(hits), std::cref(occluded), half, rays.size());
@@ -140,6 +142,53 @@ class RayCasting {
     EXPECT_TRUE(bad.empty()) << kind << ": " << bad.size() << " of " << rays.size() << " rays disagree; first: ray "
                              << (bad.empty() ? 0 : bad[0].ray) << ": " << (bad.empty() ? "" : bad[0].what);
     lastHitFraction = double(hitsSeen) / double(std::max<size_t>(1, rays.size()));
+  }
+
+  // The packet kernels trace the same rays eight at a time: every hit, its t and
+  // barycentrics, and every any-hit answer must be the single rays' bit for bit. Rays are
+  // traced as a packet only where eight share the watertight test's axis order, so they are
+  // traced twice: in the batch's order, and sorted by that order, which puts even
+  // incoherent rays into packets.
+  void expectPacketsMatchSingleRays(const Rays& rays, const std::vector<float>& hits,
+                                    const std::vector<int>& occluded, const std::string& kind) {
+    std::vector<size_t> order(rays.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    expectPacketsMatchSingleRays(rays, order, hits, occluded, kind + ", packets in the batch's order");
+    auto axisOrder = [&](size_t i) {
+      const float* d = &rays.dir[4 * i];
+      const float a[3] = {std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])};
+      const int kz = a[0] > a[1] ? (a[0] > a[2] ? 0 : 2) : (a[1] > a[2] ? 1 : 2);
+      return 2 * kz + (d[kz] < 0.f);
+    };
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return axisOrder(a) < axisOrder(b); });
+    expectPacketsMatchSingleRays(rays, order, hits, occluded, kind + ", packets sorted by axis order");
+  }
+
+  void expectPacketsMatchSingleRays(const Rays& rays, const std::vector<size_t>& order,
+                                    const std::vector<float>& hits, const std::vector<int>& occluded,
+                                    const std::string& kind) {
+    Rays sorted;
+    for (size_t i : order) {
+      sorted.org.insert(sorted.org.end(), &rays.org[4 * i], &rays.org[4 * i + 4]);
+      sorted.dir.insert(sorted.dir.end(), &rays.dir[4 * i], &rays.dir[4 * i + 4]);
+    }
+    RayQueue q = work.upload(sorted.org, sorted.dir);
+    cl::Buffer packetHits = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, q.count * 16ull + 16, "hits");
+    cl::Buffer packetOccluded =
+        allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, q.count * 4ull + 4, "occluded");
+    caster.intersectClosest(q.org, q.dir, packetHits, q.count, RayOrder::Coherent);
+    caster.intersectAny(q.org, q.dir, packetOccluded, q.count, RayOrder::Coherent);
+    const std::vector<float> ph = work.readFloat4(packetHits, q.count);
+    std::vector<int> po(q.count);
+    FH_CL(dc.queue.enqueueReadBuffer(packetOccluded, CL_TRUE, 0, q.count * 4ull, po.data()));
+    size_t differ = 0, first = 0;
+    for (size_t k = 0; k < q.count; ++k) {
+      const size_t i = order[k];
+      if (std::memcmp(&ph[4 * k], &hits[4 * i], 16) != 0 || po[k] != occluded[i]) first = differ++ ? first : k;
+    }
+    EXPECT_EQ(differ, 0u) << kind << ": packets differ from single rays on " << differ << " of " << q.count
+                          << " rays; first: ray " << order[first] << ", t " << hits[4 * order[first]] << " vs "
+                          << ph[4 * first] << ", occluded " << occluded[order[first]] << " vs " << po[first];
   }
 
   Rays download(const RayQueue& q) {

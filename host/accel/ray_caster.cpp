@@ -22,18 +22,34 @@ RayCaster::RayCaster(DeviceContext& dc, const Bvh& bvh) : dc_(dc), bvh_(dc, bvh)
       buildProgram(dc.context, dc.info.device, intersectProgram(bvh_.traversalOptions()), &buildInfo_);
   closest_ = createKernel(program, "intersect_closest");
   any_ = createKernel(program, "intersect_any");
+  closestPackets_ = createKernel(program, "intersect_closest_packets");
+  anyPackets_ = createKernel(program, "intersect_any_packets");
+}
+
+namespace {
+constexpr unsigned kPacket = FH_PACKET;  // rays per work-item in the *_packets kernels
 }
 
 void RayCaster::intersectClosest(const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& hits,
-                                 unsigned count, cl::Event* event) {
-  setKernelArgs(closest_, nodes(), blocks(), org, dir, hits, count);
-  launch(dc_, closest_, count, "intersect_closest", event);
+                                 unsigned count, RayOrder order, cl::Event* event) {
+  if (order == RayOrder::Coherent) {
+    setKernelArgs(closestPackets_, nodes(), blocks(), org, dir, hits, count);
+    launch(dc_, closestPackets_, (count + kPacket - 1) / kPacket, "intersect_closest_packets", event);
+  } else {
+    setKernelArgs(closest_, nodes(), blocks(), org, dir, hits, count);
+    launch(dc_, closest_, count, "intersect_closest", event);
+  }
 }
 
 void RayCaster::intersectAny(const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& occluded,
-                             unsigned count, cl::Event* event) {
-  setKernelArgs(any_, nodes(), blocks(), org, dir, occluded, count);
-  launch(dc_, any_, count, "intersect_any", event);
+                             unsigned count, RayOrder order, cl::Event* event) {
+  if (order == RayOrder::Coherent) {
+    setKernelArgs(anyPackets_, nodes(), blocks(), org, dir, occluded, count);
+    launch(dc_, anyPackets_, (count + kPacket - 1) / kPacket, "intersect_any_packets", event);
+  } else {
+    setKernelArgs(any_, nodes(), blocks(), org, dir, occluded, count);
+    launch(dc_, any_, count, "intersect_any", event);
+  }
 }
 
 }  // namespace fh

@@ -28,6 +28,11 @@ class DeviceBvh {
   cl::Buffer nodes_, blocks_, triangles_;
 };
 
+// How a batch of rays is laid out: coherent batches (camera rays in pixel order, where
+// neighbours in the batch take nearly the same path through the tree) are traced eight
+// at a time as packets. Either way the hits are the same, bit for bit.
+enum class RayOrder { Incoherent, Coherent };
+
 // Ray casting as an operation of its own: the BVH and the intersect kernels over arrays
 // of rays (the bench, --aov, tests). The path tracer traverses the BVH inside its stages.
 class RayCaster {
@@ -36,10 +41,10 @@ class RayCaster {
 
   // hits[i] = (t, b1, b2, BVH-order triangle bits or -1) for rays (org.xyz+tmin, dir.xyz+tmax).
   void intersectClosest(const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& hits, unsigned count,
-                        cl::Event* event = nullptr);
+                        RayOrder order = RayOrder::Incoherent, cl::Event* event = nullptr);
   // occluded[i] = 1 if anything lies on [tmin, tmax), else 0.
   void intersectAny(const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& occluded, unsigned count,
-                    cl::Event* event = nullptr);
+                    RayOrder order = RayOrder::Incoherent, cl::Event* event = nullptr);
 
   const cl::Buffer& nodes() const { return bvh_.nodes(); }
   const cl::Buffer& blocks() const { return bvh_.blocks(); }
@@ -51,7 +56,7 @@ class RayCaster {
   DeviceContext& dc_;
   DeviceBvh bvh_;
   ProgramBuildInfo buildInfo_;
-  cl::Kernel closest_, any_;
+  cl::Kernel closest_, any_, closestPackets_, anyPackets_;
 };
 
 }  // namespace fh

@@ -163,8 +163,9 @@ class SceneBench {
       LaunchTiming sum;
       for (int i = 0; i < t.passes; ++i) {
         const LaunchTiming one = timeLaunch(dc, [&](cl::Event* e) {
-          if (kind.occlusion) caster.intersectAny(kind.rays.org, kind.rays.dir, out, n, e);
-          else caster.intersectClosest(kind.rays.org, kind.rays.dir, out, n, e);
+          const RayOrder order = kind.coherent ? RayOrder::Coherent : RayOrder::Incoherent;
+          if (kind.occlusion) caster.intersectAny(kind.rays.org, kind.rays.dir, out, n, order, e);
+          else caster.intersectClosest(kind.rays.org, kind.rays.dir, out, n, order, e);
         });
         sum.wallSeconds += one.wallSeconds;
         sum.kernelSeconds += one.kernelSeconds;

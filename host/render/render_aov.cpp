@@ -33,7 +33,7 @@ Image renderAov(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const Cam
   for (int sample = 0; sample < std::max(1, s.spp); ++sample) {
     setKernelArgs(generate, cam, s.seed, unsigned(sample), 0u, org, dir, rayPixel, pixels);
     launch(dc, generate, pixels, "generate_camera_rays");
-    caster.intersectClosest(org, dir, hits, pixels);
+    caster.intersectClosest(org, dir, hits, pixels, RayOrder::Coherent);
     setKernelArgs(shade, int(s.mode), hits, rayPixel, caster.triangles(), materialOf, materialAlbedo, film, pixels);
     launch(dc, shade, pixels, "shade_aov");
   }

@@ -1,0 +1,225 @@
+// Packet traversal: eight rays of one work-item go down the 8-wide BVH together, each node
+// loaded once for all eight and its children tested one by one across the rays (float8
+// over rays, where trace_ray is float8 over children). For coherent batches (camera rays of
+// neighbouring pixels), which visit mostly the same nodes, the per-node work of single-ray
+// traversal (ordering the children, pushing, popping, the branches that mispredict) is
+// then paid once for eight rays.
+//
+// The hits are trace_ray's, bit for bit: every (ray, box) and (ray, triangle) test is the
+// same arithmetic, a box is culled only where it cannot hold the closest hit, and ties in t
+// go to the lower triangle index (closer_hit8), so the visiting order does not matter.
+#ifndef FH_INTERSECT_PACKET_H
+#define FH_INTERSECT_PACKET_H
+
+#include "intersect.h"
+
+// The rays' constants as lanes. The watertight test's axis order (kx, ky, kz) must be the
+// same for every ray of a packet: its components are then loaded once per triangle.
+typedef struct {
+  float8 org_lo_x, org_lo_y, org_lo_z, org_hi_x, org_hi_y, org_hi_z;
+  float8 inv_x, inv_y, inv_z;
+  float8 sx, sy, sz, ox, oy, oz;
+  float8 t_min;
+  int kx, ky, kz;
+} RayPacket;
+
+// Lanes at or past `count` repeat the last ray; the caller leaves them out. Returns false
+// where the rays' axis orders differ.
+FH_INLINE bool make_packet(const float3* org, const float3* dir, int count, const float* t_min, RayPacket* p) {
+  float a[15][FH_PACKET];
+  float t0[FH_PACKET];
+  const RayPrecomp first = precompute_ray(org[0], dir[0]);
+  bool shared = true;
+  for (int l = 0; l < FH_PACKET; ++l) {
+    const int k = min(l, count - 1);
+    const RayPrecomp r = precompute_ray(org[k], dir[k]);
+    shared = shared && r.kx == first.kx && r.ky == first.ky && r.kz == first.kz;
+    const float v[15] = {r.org_lo.x, r.org_lo.y, r.org_lo.z, r.org_hi.x, r.org_hi.y, r.org_hi.z, r.inv_dir.x,
+                         r.inv_dir.y, r.inv_dir.z, r.sx, r.sy, r.sz, r.ox, r.oy, r.oz};
+    for (int c = 0; c < 15; ++c) a[c][l] = v[c];
+    t0[l] = t_min[k];
+  }
+  p->org_lo_x = vload8(0, a[0]);
+  p->org_lo_y = vload8(0, a[1]);
+  p->org_lo_z = vload8(0, a[2]);
+  p->org_hi_x = vload8(0, a[3]);
+  p->org_hi_y = vload8(0, a[4]);
+  p->org_hi_z = vload8(0, a[5]);
+  p->inv_x = vload8(0, a[6]);
+  p->inv_y = vload8(0, a[7]);
+  p->inv_z = vload8(0, a[8]);
+  p->sx = vload8(0, a[9]);
+  p->sy = vload8(0, a[10]);
+  p->sz = vload8(0, a[11]);
+  p->ox = vload8(0, a[12]);
+  p->oy = vload8(0, a[13]);
+  p->oz = vload8(0, a[14]);
+  p->t_min = vload8(0, t0);
+  p->kx = first.kx;
+  p->ky = first.ky;
+  p->kz = first.kz;
+  return shared;
+}
+
+// The near distance of child `c` for each ray, +INFINITY where the ray misses it or no
+// longer needs it (t_hit: each ray's current hit, -INFINITY for rays that are done).
+FH_INLINE float8 packet_child_near(const RayPacket* p, __global const Bvh8Node* node, int c, float8 t_hit) {
+  const float8 tx0 = ((float8)(node->lo_x[c]) - p->org_lo_x) * p->inv_x;
+  const float8 tx1 = ((float8)(node->hi_x[c]) - p->org_hi_x) * p->inv_x;
+  const float8 ty0 = ((float8)(node->lo_y[c]) - p->org_lo_y) * p->inv_y;
+  const float8 ty1 = ((float8)(node->hi_y[c]) - p->org_hi_y) * p->inv_y;
+  const float8 tz0 = ((float8)(node->lo_z[c]) - p->org_lo_z) * p->inv_z;
+  const float8 tz1 = ((float8)(node->hi_z[c]) - p->org_hi_z) * p->inv_z;
+  const float8 t_near = fmax(fmax(fmin(tx0, tx1), fmin(ty0, ty1)), fmax(fmin(tz0, tz1), (float8)(0.0f)));
+  const float8 t_far = fmin(fmin(fmax(tx0, tx1), fmax(ty0, ty1)), fmin(fmax(tz0, tz1), t_hit)) * FH_SLAB_WIDEN;
+  return select(t_near, (float8)(INFINITY), t_near > t_far);
+}
+
+// Lane minimum and maximum by comparisons, which compile to single min/max instructions
+// (fmin and fmax must also handle NaNs, which these distances never are).
+FH_INLINE float min_lane(float8 x) {
+  const float4 a = x.lo < x.hi ? x.lo : x.hi;
+  const float2 b = a.lo < a.hi ? a.lo : a.hi;
+  return b.x < b.y ? b.x : b.y;
+}
+
+FH_INLINE float max_lane(float8 x) {
+  const float4 a = x.lo > x.hi ? x.lo : x.hi;
+  const float2 b = a.lo > a.hi ? a.lo : a.hi;
+  return b.x > b.y ? b.x : b.y;
+}
+
+// Pushes the children any ray hits, farthest first (by the nearest ray's distance), and
+// returns the nearest, or 0 if none is hit.
+FH_INLINE int packet_order_children(const RayPacket* p, __global const Bvh8Node* node, float8 t_hit,
+                                    int* stack_node, float* stack_t, int* sp) {
+  int ref[8];
+  float key[8];
+  int n = 0;
+  for (int c = 0; c < 8; ++c) {
+    const int child = node->child[c];
+    if (child == 0) break;  // empty slots come last
+    const float t = min_lane(packet_child_near(p, node, c, t_hit));
+    if (t == INFINITY) continue;
+    // Insertion sort by decreasing distance.
+    int j = n++;
+    while (j > 0 && key[j - 1] < t) {
+      key[j] = key[j - 1];
+      ref[j] = ref[j - 1];
+      --j;
+    }
+    key[j] = t;
+    ref[j] = child;
+  }
+  if (n == 0) return 0;
+  for (int k = 0; k < n - 1; ++k) {
+    stack_node[*sp] = ref[k];
+    stack_t[*sp] = key[k];
+    ++*sp;
+  }
+  return ref[n - 1];
+}
+
+typedef struct {
+  float8 t, b1, b2;
+  int8 triangle;  // BVH-order index, -1 while none
+} PacketHits;
+
+// The leaf's triangles one by one, each tested against all the rays: the watertight test of
+// intersect_block, lane for lane the same arithmetic. Any-hit rays that are hit are done:
+// their t becomes -INFINITY.
+FH_INLINE void packet_intersect_block(const RayPacket* p, __global const TriangleBlock8* block, PacketHits* h,
+                                      bool any_hit) {
+  const float8 zero = (float8)(0.0f);
+  for (int j = 0; j < 8; ++j) {
+    const int id = block->id[j];
+    if (id < 0) break;  // empty lanes come last
+    const float8 az = (float8)(block->v[0][p->kz][j]) - p->oz;
+    const float8 bz = (float8)(block->v[1][p->kz][j]) - p->oz;
+    const float8 cz = (float8)(block->v[2][p->kz][j]) - p->oz;
+    const float8 ax = ((float8)(block->v[0][p->kx][j]) - p->ox) - p->sx * az;
+    const float8 ay = ((float8)(block->v[0][p->ky][j]) - p->oy) - p->sy * az;
+    const float8 bx = ((float8)(block->v[1][p->kx][j]) - p->ox) - p->sx * bz;
+    const float8 by = ((float8)(block->v[1][p->ky][j]) - p->oy) - p->sy * bz;
+    const float8 cx = ((float8)(block->v[2][p->kx][j]) - p->ox) - p->sx * cz;
+    const float8 cy = ((float8)(block->v[2][p->ky][j]) - p->oy) - p->sy * cz;
+    const float8 u = cx * by - cy * bx;
+    const float8 v = ax * cy - ay * cx;
+    const float8 w = bx * ay - by * ax;
+    const int8 outside = ((u < zero) | (v < zero) | (w < zero)) & ((u > zero) | (v > zero) | (w > zero));
+    const float8 det = u + v + w;
+    const float8 t_scaled = u * p->sz * az + v * p->sz * bz + w * p->sz * cz;
+    const float8 abs_det = fabs(det);
+    const float8 ts = select(t_scaled, -t_scaled, det < zero);
+    const int8 maybe =
+        ~outside & (det != zero) & (ts >= p->t_min * abs_det) & (ts <= (h->t * abs_det) * FH_T_WIDEN);
+    if (!any(maybe)) continue;
+    const float8 quotient = t_scaled / det;
+    const int8 valid = maybe & (quotient >= p->t_min) & closer_hit8(quotient, (int8)(id), h->t, h->triangle);
+    if (!any(valid)) continue;
+    h->triangle = select(h->triangle, (int8)(id), valid);
+    if (any_hit) {
+      h->t = select(h->t, (float8)(-INFINITY), valid);
+      continue;
+    }
+    h->t = select(h->t, quotient, valid);
+    h->b1 = select(h->b1, v / det, valid);
+    h->b2 = select(h->b2, w / det, valid);
+  }
+}
+
+// Traces rays org[l] + t dir[l], t in [t_min[l], t_max[l]), for l < count (1..8), into
+// hit[l] as trace_ray would. Returns false, tracing nothing, where the rays' axis orders
+// differ (make_packet): the caller then traces them one by one.
+FH_INLINE bool trace_packet(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, const float3* org,
+                            const float3* dir, const float* t_min, const float* t_max, int count, bool any_hit,
+                            TraceHit* hit) {
+  RayPacket p;
+  if (!make_packet(org, dir, count, t_min, &p)) return false;
+  float end[FH_PACKET];
+  for (int l = 0; l < FH_PACKET; ++l) end[l] = l < count ? t_max[l] : -INFINITY;
+  PacketHits h;
+  h.t = vload8(0, end);
+  h.b1 = h.b2 = (float8)(0.0f);
+  h.triangle = (int8)(-1);
+  int stack_node[FH_TRAVERSAL_STACK];
+  float stack_t[FH_TRAVERSAL_STACK];
+  int sp = 0;
+  int ref = 0;  // the root
+  float reach = max_lane(h.t);  // the farthest any ray still needs to look
+  for (;;) {
+    if (ref >= 0) {
+      __global const Bvh8Node* node = nodes + ref;
+      ref = packet_order_children(&p, node, h.t, stack_node, stack_t, &sp);
+      if (ref != 0) continue;
+    } else {
+      packet_intersect_block(&p, blocks + ~ref, &h, any_hit);
+      reach = max_lane(h.t);
+      if (reach == -INFINITY) break;  // every any-hit ray is occluded
+    }
+    ref = 0;
+    while (sp > 0) {
+      --sp;
+      if (stack_t[sp] <= reach * FH_SLAB_WIDEN) {
+        ref = stack_node[sp];
+        break;
+      }
+    }
+    if (ref == 0) break;
+  }
+  float t[FH_PACKET], b1[FH_PACKET], b2[FH_PACKET];
+  int tri[FH_PACKET];
+  vstore8(h.t, 0, t);
+  vstore8(h.b1, 0, b1);
+  vstore8(h.b2, 0, b2);
+  vstore8(h.triangle, 0, tri);
+  for (int l = 0; l < count; ++l) {
+    hit[l].triangle = tri[l];
+    hit[l].t = tri[l] >= 0 && !any_hit ? t[l] : t_max[l];
+    hit[l].b1 = b1[l];
+    hit[l].b2 = b2[l];
+  }
+  return true;
+}
+
+#endif
