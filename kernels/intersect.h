@@ -122,21 +122,31 @@ FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8
   // and still have t >= t_max (a triangle at the current hit's distance, duplicated or
   // across a shared edge). Accept only on the quotient, the value the hit keeps.
   const float8 quotient = t_scaled / det;
-  const int8 ids = vload8(0, block->id);
-  const int8 valid = maybe & (quotient >= (float8)(t_min)) & closer_hit8(quotient, ids, (float8)(*t_max), (int8)(best));
+  int8 valid = maybe & (quotient >= (float8)(t_min)) & (quotient <= (float8)(*t_max));
   if (!any(valid)) return -1;
+  const int8 ids = vload8(0, block->id);
+  // Rare (a duplicated face, or a shared edge at the current hit's distance): only a lower
+  // index beats the current hit at equal t.
+  const int8 tied = valid & (quotient == (float8)(*t_max));
+  if (any(tied)) {
+    valid &= closer_hit8(quotient, ids, (float8)(*t_max), (int8)(best));
+    if (!any(valid)) return -1;
+  }
   if (any_hit) return lowest_bit(lane_bits(valid));
   const float8 t = select((float8)(INFINITY), quotient, valid);
-  // The nearest lane, the lowest index of equals: a min over the lanes, then a min of the
-  // indices at it.
+  // The nearest lane; among equals (rare again), the lowest index.
   const float4 m4 = fmin(t.lo, t.hi);
   const float2 m2 = fmin(m4.lo, m4.hi);
   const float nearest = fmin(m2.x, m2.y);
   const int8 at_nearest = valid & (t == (float8)(nearest));
-  const int8 id_at = select((int8)(INT_MAX), ids, at_nearest);
-  const int4 i4 = min(id_at.lo, id_at.hi);
-  const int2 i2 = min(i4.lo, i4.hi);
-  const int lowest = lowest_bit(lane_bits(at_nearest & (ids == (int8)(min(i2.x, i2.y)))));
+  uint lanes = lane_bits(at_nearest);
+  if (lanes & (lanes - 1)) {
+    const int8 id_at = select((int8)(INT_MAX), ids, at_nearest);
+    const int4 i4 = min(id_at.lo, id_at.hi);
+    const int2 i2 = min(i4.lo, i4.hi);
+    lanes = lane_bits(at_nearest & (ids == (int8)(min(i2.x, i2.y))));
+  }
+  const int lowest = lowest_bit(lanes);
   *t_max = nearest;
   // Divided in all lanes at once and picked out in registers (a store and reload per value
   // stalled here); the unpicked lanes' quotients, infinite or not, are dropped.
