@@ -115,8 +115,7 @@ FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8
   // Compare t against the interval without dividing: flip by det's sign.
   const float8 abs_det = fabs(det);
   const float8 ts = select(t_scaled, -t_scaled, det < zero);
-  const int8 maybe =
-      ~outside & (det != zero) & (ts >= t_min * abs_det) & (ts <= (*t_max * abs_det) * FH_T_WIDEN);
+  const int8 maybe = ~outside & (det != zero) & (ts >= t_min * abs_det) & (ts <= (*t_max * FH_T_WIDEN) * abs_det);
   if (!any(maybe)) return -1;
   // The products above round differently from the quotient below: a lane can pass them
   // and still have t >= t_max (a triangle at the current hit's distance, duplicated or

@@ -152,7 +152,7 @@ FH_INLINE void packet_intersect_block(const RayPacket* p, __global const Triangl
     const float8 abs_det = fabs(det);
     const float8 ts = select(t_scaled, -t_scaled, det < zero);
     const int8 maybe =
-        ~outside & (det != zero) & (ts >= p->t_min * abs_det) & (ts <= (h->t * abs_det) * FH_T_WIDEN);
+        ~outside & (det != zero) & (ts >= p->t_min * abs_det) & (ts <= (h->t * FH_T_WIDEN) * abs_det);
     if (!any(maybe)) continue;
     const float8 quotient = t_scaled / det;
     const int8 valid = maybe & (quotient >= p->t_min) & closer_hit8(quotient, (int8)(id), h->t, h->triangle);
