@@ -23,42 +23,63 @@ typedef struct {
   int kx, ky, kz;
 } RayPacket;
 
-// Lanes at or past `count` repeat the last ray; the caller leaves them out. Returns false
-// where the rays' axis orders differ.
+// Lane for lane x, y or z as k (the same for every lane) is 0, 1 or 2.
+FH_INLINE float8 axis_lanes(float8 x, float8 y, float8 z, int k) { return k == 0 ? x : (k == 1 ? y : z); }
+
+// Slab-test constants of one axis for all lanes, as precompute_ray makes them.
+FH_INLINE void slab_lanes(float8 o, float8 d, float8* org_lo, float8* org_hi, float8* inv) {
+  const float8 tiny = (float8)(1e-30f);
+  const int8 flat = fabs(d) < tiny;
+  const float8 eps = fmax(fabs(o), (float8)(1.0f)) * 0x1p-20f;
+  *inv = 1.0f / select(d, tiny, flat);
+  *org_lo = select(o, o + eps, flat);
+  *org_hi = select(o, o - eps, flat);
+}
+
+// precompute_ray for all lanes at once (the same operations, so the same bits). Lanes at or
+// past `count` repeat the last ray; the caller leaves them out. Returns false where the
+// rays' axis orders differ.
 FH_INLINE bool make_packet(const float3* org, const float3* dir, int count, const float* t_min, RayPacket* p) {
-  float a[15][FH_PACKET];
-  float t0[FH_PACKET];
-  const RayPrecomp first = precompute_ray(org[0], dir[0]);
-  bool shared = true;
+  float a[7][FH_PACKET];
   for (int l = 0; l < FH_PACKET; ++l) {
     const int k = min(l, count - 1);
-    const RayPrecomp r = precompute_ray(org[k], dir[k]);
-    shared = shared && r.kx == first.kx && r.ky == first.ky && r.kz == first.kz;
-    const float v[15] = {r.org_lo.x, r.org_lo.y, r.org_lo.z, r.org_hi.x, r.org_hi.y, r.org_hi.z, r.inv_dir.x,
-                         r.inv_dir.y, r.inv_dir.z, r.sx, r.sy, r.sz, r.ox, r.oy, r.oz};
-    for (int c = 0; c < 15; ++c) a[c][l] = v[c];
-    t0[l] = t_min[k];
+    a[0][l] = org[k].x;
+    a[1][l] = org[k].y;
+    a[2][l] = org[k].z;
+    a[3][l] = dir[k].x;
+    a[4][l] = dir[k].y;
+    a[5][l] = dir[k].z;
+    a[6][l] = t_min[k];
   }
-  p->org_lo_x = vload8(0, a[0]);
-  p->org_lo_y = vload8(0, a[1]);
-  p->org_lo_z = vload8(0, a[2]);
-  p->org_hi_x = vload8(0, a[3]);
-  p->org_hi_y = vload8(0, a[4]);
-  p->org_hi_z = vload8(0, a[5]);
-  p->inv_x = vload8(0, a[6]);
-  p->inv_y = vload8(0, a[7]);
-  p->inv_z = vload8(0, a[8]);
-  p->sx = vload8(0, a[9]);
-  p->sy = vload8(0, a[10]);
-  p->sz = vload8(0, a[11]);
-  p->ox = vload8(0, a[12]);
-  p->oy = vload8(0, a[13]);
-  p->oz = vload8(0, a[14]);
-  p->t_min = vload8(0, t0);
-  p->kx = first.kx;
-  p->ky = first.ky;
-  p->kz = first.kz;
-  return shared;
+  const float8 ox = vload8(0, a[0]), oy = vload8(0, a[1]), oz = vload8(0, a[2]);
+  const float8 dx = vload8(0, a[3]), dy = vload8(0, a[4]), dz = vload8(0, a[5]);
+  const float8 ax = fabs(dx), ay = fabs(dy), az = fabs(dz);
+  const int8 kz = select(select((int8)(2), (int8)(1), ay > az), select((int8)(2), (int8)(0), ax > az), ax > ay);
+  const int kz0 = kz.s0;
+  const float8 d_kz = axis_lanes(dx, dy, dz, kz0);
+  const int8 down = d_kz < (float8)(0.0f);
+  if (!all(kz == (int8)(kz0)) || (any(down) && !all(down))) return false;
+  int kx = kz0 == 2 ? 0 : kz0 + 1;
+  int ky = kx == 2 ? 0 : kx + 1;
+  if (down.s0) {  // keep the sheared triangle's winding, as precompute_ray does
+    const int t = kx;
+    kx = ky;
+    ky = t;
+  }
+  p->kx = kx;
+  p->ky = ky;
+  p->kz = kz0;
+  p->sx = axis_lanes(dx, dy, dz, kx) / d_kz;
+  p->sy = axis_lanes(dx, dy, dz, ky) / d_kz;
+  p->sz = 1.0f / d_kz;
+  p->ox = axis_lanes(ox, oy, oz, kx);
+  p->oy = axis_lanes(ox, oy, oz, ky);
+  p->oz = axis_lanes(ox, oy, oz, kz0);
+  slab_lanes(ox, dx, &p->org_lo_x, &p->org_hi_x, &p->inv_x);
+  slab_lanes(oy, dy, &p->org_lo_y, &p->org_hi_y, &p->inv_y);
+  slab_lanes(oz, dz, &p->org_lo_z, &p->org_hi_z, &p->inv_z);
+  p->t_min = vload8(0, a[6]);
+  return true;
 }
 
 // The near distance of child `c` for each ray, +INFINITY where the ray misses it or no
