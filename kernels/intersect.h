@@ -30,6 +30,20 @@ FH_INLINE uint lane_bits(int8 lanes) { return (uint)or_lanes(lanes & (int8)(1, 2
 // included (bits are masked, not added).
 FH_INLINE float lane_value(float8 x, int8 picked) { return as_float(or_lanes(as_int8(x) & picked)); }
 
+// Lane minimum and maximum by comparisons, which compile to single min/max instructions
+// (fmin and fmax must also handle NaNs, which the distances they serve never are).
+FH_INLINE float min_lane(float8 x) {
+  const float4 a = x.lo < x.hi ? x.lo : x.hi;
+  const float2 b = a.lo < a.hi ? a.lo : a.hi;
+  return b.x < b.y ? b.x : b.y;
+}
+
+FH_INLINE float max_lane(float8 x) {
+  const float4 a = x.lo > x.hi ? x.lo : x.hi;
+  const float2 b = a.lo > a.hi ? a.lo : a.hi;
+  return b.x > b.y ? b.x : b.y;
+}
+
 // The index of the lowest set bit of m (m != 0). clz is OpenCL 1.2; ctz is not.
 FH_INLINE int lowest_bit(uint m) { return 31 - (int)clz(m & (0u - m)); }
 
@@ -91,6 +105,39 @@ FH_INLINE int8 closer_hit8(float8 t, int8 id, float8 t_max, int8 best) {
   return (t < t_max) | ((t == t_max) & (id < best) & (id >= (int8)(0)));
 }
 
+// The watertight test's arithmetic on eight (ray, triangle) pairs, whichever of the two is
+// spread over the lanes (a leaf's eight triangles for one ray, or one triangle for a
+// packet's eight rays), so both find the same bits. Vertex coordinates come in the ray's
+// axis order (x: kx, y: ky, z: kz), as do the origin o and the shear s.
+typedef struct {
+  float8 v, w, det, t_scaled;  // barycentrics of v1 and v2 are v / det and w / det; t = t_scaled / det
+  // Inside the edges, not degenerate, and t in [t_min, t_max] by the division-free test
+  // (widened at t_max by FH_T_WIDEN, so a tie with the current hit is never lost to it).
+  int8 maybe;
+} WatertightLanes;
+
+FH_INLINE WatertightLanes watertight_lanes(float8 x0, float8 y0, float8 z0, float8 x1, float8 y1, float8 z1,
+                                           float8 x2, float8 y2, float8 z2, float8 ox, float8 oy, float8 oz,
+                                           float8 sx, float8 sy, float8 sz, float8 t_min, float8 t_max) {
+  const float8 az = z0 - oz, bz = z1 - oz, cz = z2 - oz;
+  const float8 ax = (x0 - ox) - sx * az, ay = (y0 - oy) - sy * az;
+  const float8 bx = (x1 - ox) - sx * bz, by = (y1 - oy) - sy * bz;
+  const float8 cx = (x2 - ox) - sx * cz, cy = (y2 - oy) - sy * cz;
+  WatertightLanes e;
+  const float8 u = cx * by - cy * bx;
+  e.v = ax * cy - ay * cx;
+  e.w = bx * ay - by * ax;
+  const float8 zero = (float8)(0.0f);
+  const int8 outside = ((u < zero) | (e.v < zero) | (e.w < zero)) & ((u > zero) | (e.v > zero) | (e.w > zero));
+  e.det = u + e.v + e.w;
+  e.t_scaled = u * sz * az + e.v * sz * bz + e.w * sz * cz;
+  // Compare t against the interval without dividing: flip by det's sign.
+  const float8 abs_det = fabs(e.det);
+  const float8 ts = select(e.t_scaled, -e.t_scaled, e.det < zero);
+  e.maybe = ~outside & (e.det != zero) & (ts >= t_min * abs_det) & (ts <= (t_max * FH_T_WIDEN) * abs_det);
+  return e;
+}
+
 // The watertight test on the eight triangles of a leaf at once. Returns the lane of the
 // closest hit in [t_min, *t_max) that beats the current one (`best`, see closer_hit8),
 // updating *t_max and the barycentrics b1, b2 of v1 and v2, or -1. An any-hit query takes
@@ -101,26 +148,17 @@ FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8
   __global const float* v1 = block->v[1][0];
   __global const float* v2 = block->v[2][0];
   const int kx = 8 * r->kx, ky = 8 * r->ky, kz = 8 * r->kz;
-  const float8 az = vload8(0, v0 + kz) - r->oz, bz = vload8(0, v1 + kz) - r->oz, cz = vload8(0, v2 + kz) - r->oz;
-  const float8 ax = (vload8(0, v0 + kx) - r->ox) - r->sx * az, ay = (vload8(0, v0 + ky) - r->oy) - r->sy * az;
-  const float8 bx = (vload8(0, v1 + kx) - r->ox) - r->sx * bz, by = (vload8(0, v1 + ky) - r->oy) - r->sy * bz;
-  const float8 cx = (vload8(0, v2 + kx) - r->ox) - r->sx * cz, cy = (vload8(0, v2 + ky) - r->oy) - r->sy * cz;
-  const float8 u = cx * by - cy * bx;
-  const float8 v = ax * cy - ay * cx;
-  const float8 w = bx * ay - by * ax;
-  const float8 zero = (float8)(0.0f);
-  const int8 outside = ((u < zero) | (v < zero) | (w < zero)) & ((u > zero) | (v > zero) | (w > zero));
-  const float8 det = u + v + w;
-  const float8 t_scaled = u * r->sz * az + v * r->sz * bz + w * r->sz * cz;
-  // Compare t against the interval without dividing: flip by det's sign.
-  const float8 abs_det = fabs(det);
-  const float8 ts = select(t_scaled, -t_scaled, det < zero);
-  const int8 maybe = ~outside & (det != zero) & (ts >= t_min * abs_det) & (ts <= (*t_max * FH_T_WIDEN) * abs_det);
+  const WatertightLanes e = watertight_lanes(
+      vload8(0, v0 + kx), vload8(0, v0 + ky), vload8(0, v0 + kz), vload8(0, v1 + kx), vload8(0, v1 + ky),
+      vload8(0, v1 + kz), vload8(0, v2 + kx), vload8(0, v2 + ky), vload8(0, v2 + kz), (float8)(r->ox),
+      (float8)(r->oy), (float8)(r->oz), (float8)(r->sx), (float8)(r->sy), (float8)(r->sz), (float8)(t_min),
+      (float8)(*t_max));
+  const int8 maybe = e.maybe;
   if (!any(maybe)) return -1;
-  // The products above round differently from the quotient below: a lane can pass them
+  // The division-free test rounds differently from the quotient below: a lane can pass it
   // and still have t >= t_max (a triangle at the current hit's distance, duplicated or
   // across a shared edge). Accept only on the quotient, the value the hit keeps.
-  const float8 quotient = t_scaled / det;
+  const float8 quotient = e.t_scaled / e.det;
   int8 valid = maybe & (quotient >= (float8)(t_min)) & (quotient <= (float8)(*t_max));
   if (!any(valid)) return -1;
   const int8 ids = vload8(0, block->id);
@@ -134,9 +172,7 @@ FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8
   if (any_hit) return lowest_bit(lane_bits(valid));
   const float8 t = select((float8)(INFINITY), quotient, valid);
   // The nearest lane; among equals (rare again), the lowest index.
-  const float4 m4 = fmin(t.lo, t.hi);
-  const float2 m2 = fmin(m4.lo, m4.hi);
-  const float nearest = fmin(m2.x, m2.y);
+  const float nearest = min_lane(t);
   const int8 at_nearest = valid & (t == (float8)(nearest));
   uint lanes = lane_bits(at_nearest);
   if (lanes & (lanes - 1)) {
@@ -150,8 +186,8 @@ FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8
   // Divided in all lanes at once and picked out in registers (a store and reload per value
   // stalled here); the unpicked lanes' quotients, infinite or not, are dropped.
   const int8 picked = (int8)(lowest) == (int8)(0, 1, 2, 3, 4, 5, 6, 7);
-  *b1 = lane_value(v / det, picked);
-  *b2 = lane_value(w / det, picked);
+  *b1 = lane_value(e.v / e.det, picked);
+  *b2 = lane_value(e.w / e.det, picked);
   return lowest;
 }
 

@@ -96,20 +96,6 @@ FH_INLINE float8 packet_child_near(const RayPacket* p, __global const Bvh8Node* 
   return select(t_near, (float8)(INFINITY), t_near > t_far);
 }
 
-// Lane minimum and maximum by comparisons, which compile to single min/max instructions
-// (fmin and fmax must also handle NaNs, which these distances never are).
-FH_INLINE float min_lane(float8 x) {
-  const float4 a = x.lo < x.hi ? x.lo : x.hi;
-  const float2 b = a.lo < a.hi ? a.lo : a.hi;
-  return b.x < b.y ? b.x : b.y;
-}
-
-FH_INLINE float max_lane(float8 x) {
-  const float4 a = x.lo > x.hi ? x.lo : x.hi;
-  const float2 b = a.lo > a.hi ? a.lo : a.hi;
-  return b.x > b.y ? b.x : b.y;
-}
-
 // Pushes the children any ray hits, farthest first (by the nearest ray's distance), and
 // returns the nearest, or 0 if none is hit.
 FH_INLINE int packet_order_children(const RayPacket* p, __global const Bvh8Node* node, float8 t_hit,
@@ -151,31 +137,17 @@ typedef struct {
 // their t becomes -INFINITY.
 FH_INLINE void packet_intersect_block(const RayPacket* p, __global const TriangleBlock8* block, PacketHits* h,
                                       bool any_hit) {
-  const float8 zero = (float8)(0.0f);
   for (int j = 0; j < 8; ++j) {
     const int id = block->id[j];
     if (id < 0) break;  // empty lanes come last
-    const float8 az = (float8)(block->v[0][p->kz][j]) - p->oz;
-    const float8 bz = (float8)(block->v[1][p->kz][j]) - p->oz;
-    const float8 cz = (float8)(block->v[2][p->kz][j]) - p->oz;
-    const float8 ax = ((float8)(block->v[0][p->kx][j]) - p->ox) - p->sx * az;
-    const float8 ay = ((float8)(block->v[0][p->ky][j]) - p->oy) - p->sy * az;
-    const float8 bx = ((float8)(block->v[1][p->kx][j]) - p->ox) - p->sx * bz;
-    const float8 by = ((float8)(block->v[1][p->ky][j]) - p->oy) - p->sy * bz;
-    const float8 cx = ((float8)(block->v[2][p->kx][j]) - p->ox) - p->sx * cz;
-    const float8 cy = ((float8)(block->v[2][p->ky][j]) - p->oy) - p->sy * cz;
-    const float8 u = cx * by - cy * bx;
-    const float8 v = ax * cy - ay * cx;
-    const float8 w = bx * ay - by * ax;
-    const int8 outside = ((u < zero) | (v < zero) | (w < zero)) & ((u > zero) | (v > zero) | (w > zero));
-    const float8 det = u + v + w;
-    const float8 t_scaled = u * p->sz * az + v * p->sz * bz + w * p->sz * cz;
-    const float8 abs_det = fabs(det);
-    const float8 ts = select(t_scaled, -t_scaled, det < zero);
-    const int8 maybe =
-        ~outside & (det != zero) & (ts >= p->t_min * abs_det) & (ts <= (h->t * FH_T_WIDEN) * abs_det);
+    const WatertightLanes e = watertight_lanes(
+        (float8)(block->v[0][p->kx][j]), (float8)(block->v[0][p->ky][j]), (float8)(block->v[0][p->kz][j]),
+        (float8)(block->v[1][p->kx][j]), (float8)(block->v[1][p->ky][j]), (float8)(block->v[1][p->kz][j]),
+        (float8)(block->v[2][p->kx][j]), (float8)(block->v[2][p->ky][j]), (float8)(block->v[2][p->kz][j]), p->ox,
+        p->oy, p->oz, p->sx, p->sy, p->sz, p->t_min, h->t);
+    const int8 maybe = e.maybe;
     if (!any(maybe)) continue;
-    const float8 quotient = t_scaled / det;
+    const float8 quotient = e.t_scaled / e.det;
     const int8 valid = maybe & (quotient >= p->t_min) & closer_hit8(quotient, (int8)(id), h->t, h->triangle);
     if (!any(valid)) continue;
     h->triangle = select(h->triangle, (int8)(id), valid);
@@ -184,8 +156,8 @@ FH_INLINE void packet_intersect_block(const RayPacket* p, __global const Triangl
       continue;
     }
     h->t = select(h->t, quotient, valid);
-    h->b1 = select(h->b1, v / det, valid);
-    h->b2 = select(h->b2, w / det, valid);
+    h->b1 = select(h->b1, e.v / e.det, valid);
+    h->b2 = select(h->b2, e.w / e.det, valid);
   }
 }
 

@@ -27,29 +27,26 @@ RayCaster::RayCaster(DeviceContext& dc, const Bvh& bvh) : dc_(dc), bvh_(dc, bvh)
 }
 
 namespace {
-constexpr unsigned kPacket = FH_PACKET;  // rays per work-item in the *_packets kernels
+// Work-items for `count` rays: one per ray, or one per packet of FH_PACKET rays.
+size_t workItems(unsigned count, RayOrder order) {
+  return order == RayOrder::Coherent ? (count + FH_PACKET - 1) / FH_PACKET : count;
 }
+}  // namespace
 
 void RayCaster::intersectClosest(const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& hits,
                                  unsigned count, RayOrder order, cl::Event* event) {
-  if (order == RayOrder::Coherent) {
-    setKernelArgs(closestPackets_, nodes(), blocks(), org, dir, hits, count);
-    launch(dc_, closestPackets_, (count + kPacket - 1) / kPacket, "intersect_closest_packets", event);
-  } else {
-    setKernelArgs(closest_, nodes(), blocks(), org, dir, hits, count);
-    launch(dc_, closest_, count, "intersect_closest", event);
-  }
+  const bool packets = order == RayOrder::Coherent;
+  cl::Kernel& kernel = packets ? closestPackets_ : closest_;
+  setKernelArgs(kernel, nodes(), blocks(), org, dir, hits, count);
+  launch(dc_, kernel, workItems(count, order), packets ? "intersect_closest_packets" : "intersect_closest", event);
 }
 
 void RayCaster::intersectAny(const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& occluded,
                              unsigned count, RayOrder order, cl::Event* event) {
-  if (order == RayOrder::Coherent) {
-    setKernelArgs(anyPackets_, nodes(), blocks(), org, dir, occluded, count);
-    launch(dc_, anyPackets_, (count + kPacket - 1) / kPacket, "intersect_any_packets", event);
-  } else {
-    setKernelArgs(any_, nodes(), blocks(), org, dir, occluded, count);
-    launch(dc_, any_, count, "intersect_any", event);
-  }
+  const bool packets = order == RayOrder::Coherent;
+  cl::Kernel& kernel = packets ? anyPackets_ : any_;
+  setKernelArgs(kernel, nodes(), blocks(), org, dir, occluded, count);
+  launch(dc_, kernel, workItems(count, order), packets ? "intersect_any_packets" : "intersect_any", event);
 }
 
 }  // namespace fh
