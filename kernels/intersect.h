@@ -4,6 +4,7 @@
 #ifndef FH_INTERSECT_H
 #define FH_INTERSECT_H
 
+#include "masks.h"
 #include "types.h"
 
 // Watertightness needs the edge functions of two triangles that share an edge to be
@@ -16,22 +17,16 @@
 #define FH_TRAVERSAL_STACK 64
 #endif
 
-// The eight lanes OR-ed together.
-FH_INLINE int or_lanes(int8 x) {
-  const int4 a = x.lo | x.hi;
-  const int2 b = a.lo | a.hi;
-  return b.x | b.y;
-}
-
-// Bit i set where lane i of `lanes` is set (lanes are 0 or -1).
-FH_INLINE uint lane_bits(int8 lanes) { return (uint)or_lanes(lanes & (int8)(1, 2, 4, 8, 16, 32, 64, 128)); }
-
 // Lane l of x, where `picked` is set in lane l only: exact for every value, -0 and NaN
 // included (bits are masked, not added).
 FH_INLINE float lane_value(float8 x, int8 picked) { return as_float(or_lanes(as_int8(x) & picked)); }
 
-// Lane minimum and maximum by comparisons, which compile to single min/max instructions
-// (fmin and fmax must also handle NaNs, which the distances they serve never are).
+// Minimum and maximum by comparisons, which compile to single min/max instructions (fmin
+// and fmax must also handle NaNs, which the distances they serve never are: ray
+// directions' inverses are finite, so slab distances are never 0 * inf).
+FH_INLINE float8 min8(float8 a, float8 b) { return a < b ? a : b; }
+FH_INLINE float8 max8(float8 a, float8 b) { return a > b ? a : b; }
+
 FH_INLINE float min_lane(float8 x) {
   const float4 a = x.lo < x.hi ? x.lo : x.hi;
   const float2 b = a.lo < a.hi ? a.lo : a.hi;
@@ -154,20 +149,20 @@ FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8
       (float8)(r->oy), (float8)(r->oz), (float8)(r->sx), (float8)(r->sy), (float8)(r->sz), (float8)(t_min),
       (float8)(*t_max));
   const int8 maybe = e.maybe;
-  if (!any(maybe)) return -1;
+  if (!any_lane(maybe)) return -1;
   // The division-free test rounds differently from the quotient below: a lane can pass it
   // and still have t >= t_max (a triangle at the current hit's distance, duplicated or
   // across a shared edge). Accept only on the quotient, the value the hit keeps.
   const float8 quotient = e.t_scaled / e.det;
   int8 valid = maybe & (quotient >= (float8)(t_min)) & (quotient <= (float8)(*t_max));
-  if (!any(valid)) return -1;
+  if (!any_lane(valid)) return -1;
   const int8 ids = vload8(0, block->id);
   // Rare (a duplicated face, or a shared edge at the current hit's distance): only a lower
   // index beats the current hit at equal t.
   const int8 tied = valid & (quotient == (float8)(*t_max));
-  if (any(tied)) {
+  if (any_lane(tied)) {
     valid &= closer_hit8(quotient, ids, (float8)(*t_max), (int8)(best));
-    if (!any(valid)) return -1;
+    if (!any_lane(valid)) return -1;
   }
   if (any_hit) return lowest_bit(lane_bits(valid));
   const float8 t = select((float8)(INFINITY), quotient, valid);
@@ -204,8 +199,8 @@ FH_INLINE float8 intersect_children(const RayPrecomp* r, __global const Bvh8Node
   const float8 ty1 = (vload8(0, node->hi_y) - (float8)(r->org_hi.y)) * iy;
   const float8 tz0 = (vload8(0, node->lo_z) - (float8)(r->org_lo.z)) * iz;
   const float8 tz1 = (vload8(0, node->hi_z) - (float8)(r->org_hi.z)) * iz;
-  const float8 t_near = fmax(fmax(fmin(tx0, tx1), fmin(ty0, ty1)), fmax(fmin(tz0, tz1), (float8)(0.0f)));
-  const float8 t_far = fmin(fmin(fmax(tx0, tx1), fmax(ty0, ty1)), fmin(fmax(tz0, tz1), (float8)(t_max))) *
+  const float8 t_near = max8(max8(min8(tx0, tx1), min8(ty0, ty1)), max8(min8(tz0, tz1), (float8)(0.0f)));
+  const float8 t_far = min8(min8(max8(tx0, tx1), max8(ty0, ty1)), min8(max8(tz0, tz1), (float8)(t_max))) *
                        FH_SLAB_WIDEN;
   const int8 empty = vload8(0, node->child) == (int8)(0);
   const int8 miss = (t_near > t_far) | empty;

@@ -58,7 +58,7 @@ FH_INLINE bool make_packet(const float3* org, const float3* dir, int count, cons
   const int kz0 = kz.s0;
   const float8 d_kz = axis_lanes(dx, dy, dz, kz0);
   const int8 down = d_kz < (float8)(0.0f);
-  if (!all(kz == (int8)(kz0)) || (any(down) && !all(down))) return false;
+  if (!all_lanes(kz == (int8)(kz0)) || (any_lane(down) && !all_lanes(down))) return false;
   int kx = kz0 == 2 ? 0 : kz0 + 1;
   int ky = kx == 2 ? 0 : kx + 1;
   if (down.s0) {  // keep the sheared triangle's winding, as precompute_ray does
@@ -91,8 +91,8 @@ FH_INLINE float8 packet_child_near(const RayPacket* p, __global const Bvh8Node* 
   const float8 ty1 = ((float8)(node->hi_y[c]) - p->org_hi_y) * p->inv_y;
   const float8 tz0 = ((float8)(node->lo_z[c]) - p->org_lo_z) * p->inv_z;
   const float8 tz1 = ((float8)(node->hi_z[c]) - p->org_hi_z) * p->inv_z;
-  const float8 t_near = fmax(fmax(fmin(tx0, tx1), fmin(ty0, ty1)), fmax(fmin(tz0, tz1), (float8)(0.0f)));
-  const float8 t_far = fmin(fmin(fmax(tx0, tx1), fmax(ty0, ty1)), fmin(fmax(tz0, tz1), t_hit)) * FH_SLAB_WIDEN;
+  const float8 t_near = max8(max8(min8(tx0, tx1), min8(ty0, ty1)), max8(min8(tz0, tz1), (float8)(0.0f)));
+  const float8 t_far = min8(min8(max8(tx0, tx1), max8(ty0, ty1)), min8(max8(tz0, tz1), t_hit)) * FH_SLAB_WIDEN;
   return select(t_near, (float8)(INFINITY), t_near > t_far);
 }
 
@@ -146,10 +146,10 @@ FH_INLINE void packet_intersect_block(const RayPacket* p, __global const Triangl
         (float8)(block->v[2][p->kx][j]), (float8)(block->v[2][p->ky][j]), (float8)(block->v[2][p->kz][j]), p->ox,
         p->oy, p->oz, p->sx, p->sy, p->sz, p->t_min, h->t);
     const int8 maybe = e.maybe;
-    if (!any(maybe)) continue;
+    if (!any_lane(maybe)) continue;
     const float8 quotient = e.t_scaled / e.det;
     const int8 valid = maybe & (quotient >= p->t_min) & closer_hit8(quotient, (int8)(id), h->t, h->triangle);
-    if (!any(valid)) continue;
+    if (!any_lane(valid)) continue;
     h->triangle = select(h->triangle, (int8)(id), valid);
     if (any_hit) {
       h->t = select(h->t, (float8)(-INFINITY), valid);

@@ -14,6 +14,7 @@
 #ifndef FH_LANES_H
 #define FH_LANES_H
 
+#include "masks.h"
 #include "types.h"
 
 #ifndef FH_LANES
@@ -38,7 +39,7 @@ typedef float8 lfloat;
 typedef int8 lint;
 typedef uint8 luint;
 typedef int8 lmask;
-#define lanes_any(m) any(m)
+#define lanes_any(m) any_lane(m)
 #define LANE(v, l) ((v)[l])
 #define lconvert_float(x) convert_float8(x)
 #define lconvert_uint(x) convert_uint8(x)
