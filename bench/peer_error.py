@@ -11,13 +11,19 @@ same axes, each image measured against one long reference with Mitsuba's compare
 Then, at equal time, each fredholm method renders with --time set to the seconds Mitsuba
 ldsampler took for the largest spp (the issue's target: fredholm's relMSE there <= Mitsuba's).
 
+  bench/peer_error.py --ref REF.exr --equal-time-rounds N [--spp 256] [--methods mis]
+
+measures only the equal-time point, N times: each round renders Mitsuba ldsampler at the
+largest spp, then each fredholm method for the seconds that render took (the order
+swapped every other round, new seeds each round), and prints every round and the medians.
+
 Renders run one after another (never two at once): fredholm's seconds are --stats
 `seconds` (devices ready to last pass merged, after a warm-up render per method has filled
 PoCL's kernel cache), Mitsuba's `seconds_render` (after its JIT
 warm-up). Writes OUT/cornell-peers.csv and OUT/cornell-peers.png (log-log, with a slope -1
 guide: an unbiased estimator's relMSE falls as 1/time).
 """
-import argparse, csv, json, os, subprocess, sys, tempfile
+import argparse, csv, json, os, statistics, subprocess, sys, tempfile
 
 import matplotlib
 
@@ -35,13 +41,13 @@ def relmse(python, ref, image):
     return json.loads(out.strip().splitlines()[-1])["relMSE"]
 
 
-def fredholm(method, spp, extra, workdir, seconds=None):
+def fredholm(method, spp, extra, workdir, seconds=None, seed=None):
     """Renders spp samples per pixel, or as many as fit in `seconds`; returns the image, the
     seconds taken and the samples per pixel rendered."""
     image, stats = os.path.join(workdir, "f.exr"), os.path.join(workdir, "f.json")
     budget = ["--time", str(seconds)] if seconds else []
     subprocess.run([os.path.join(ROOT, "build", "fredholm"), "render", "--width", "512", "--height", "512",
-                    "--spp", str(spp), "--method", method, "--seed", str(spp)] + budget + CAMERA + extra +
+                    "--spp", str(spp), "--method", method, "--seed", str(seed or spp)] + budget + CAMERA + extra +
                    ["-o", image, "--force", "--stats", stats], check=True, stdout=subprocess.DEVNULL,
                    stderr=subprocess.DEVNULL)
     with open(stats) as f:
@@ -49,10 +55,10 @@ def fredholm(method, spp, extra, workdir, seconds=None):
     return image, doc["seconds"], doc["samples"] // (512 * 512)
 
 
-def mitsuba(python, sampler, spp, workdir):
+def mitsuba(python, sampler, spp, workdir, seed=None):
     image = os.path.join(workdir, "m.exr")
     out = subprocess.run([python, os.path.join(PEER, "cbox.py"), "--variant", "llvm_ad_rgb", "--sampler", sampler,
-                          "--spp", str(spp), "--seed", str(spp), "--max-bounces", "16", "--out", image],
+                          "--spp", str(spp), "--seed", str(seed or spp), "--max-bounces", "16", "--out", image],
                          check=True, capture_output=True, text=True).stdout
     return image, json.loads([l for l in out.splitlines() if l.startswith("{")][-1])["seconds_render"]
 
@@ -67,8 +73,11 @@ def main():
     ap.add_argument("--methods", default="mis,nee,pt")
     ap.add_argument("--mitsuba-python", default="/opt/mi-venv/bin/python")
     ap.add_argument("--out", default=os.path.join(ROOT, "bench", "peers"))
+    ap.add_argument("--equal-time-rounds", type=int, default=0)
     opts = ap.parse_args(argv)
     os.makedirs(opts.out, exist_ok=True)
+    if opts.equal_time_rounds:
+        return equal_time_rounds(opts, extra)
     rows, equal_time = [], []
     with tempfile.TemporaryDirectory() as workdir:
         for method in opts.methods.split(","):
@@ -108,6 +117,53 @@ def main():
     plt.legend(fontsize=8)
     plt.grid(True, which="both", alpha=0.3)
     plt.savefig(os.path.join(opts.out, "cornell-peers.png"), dpi=100, bbox_inches="tight")
+
+
+def equal_time_rounds(opts, extra):
+    spp, methods = max(int(s) for s in opts.spp.split(",")), opts.methods.split(",")
+    rows = []
+    with tempfile.TemporaryDirectory() as workdir:
+        for method in methods:
+            fredholm(method, 1, extra, workdir)  # kernel compilation, kept out of the rounds
+        mitsuba(opts.mitsuba_python, "ldsampler", spp, workdir)  # the same for Mitsuba's JIT cache
+        budget = None
+        for k in range(1, opts.equal_time_rounds + 1):
+            seed = 1000 * k + spp
+
+            def peer():
+                image, seconds = mitsuba(opts.mitsuba_python, "ldsampler", spp, workdir, seed)
+                return ("mitsuba ldsampler", k, spp, seconds, relmse(opts.mitsuba_python, opts.ref, image))
+
+            def ours(budget):
+                out = []
+                for method in methods:
+                    image, seconds, reached = fredholm(method, 4096, extra, workdir, seconds=budget, seed=seed)
+                    error = relmse(opts.mitsuba_python, opts.ref, image)
+                    out.append(("fredholm " + method, k, reached, seconds, error))
+                return out
+
+            # Mitsuba first in odd rounds; fredholm first in even ones, for the seconds
+            # Mitsuba took in the round before.
+            if k % 2:
+                round_rows = [peer()]
+                budget = round_rows[0][3]
+                round_rows += ours(budget)
+            else:
+                round_rows = ours(budget)
+                round_rows.append(peer())
+                budget = round_rows[-1][3]
+            rows += round_rows
+            for r in round_rows:
+                print("round", k, r[0], "spp", r[2], "seconds %.2f" % r[3], "relMSE %.4g" % r[4], flush=True)
+    names = list(dict.fromkeys(r[0] for r in rows))
+    for name in names:
+        mine = [r for r in rows if r[0] == name]
+        print("median", name, "relMSE %.4g" % statistics.median(r[4] for r in mine),
+              "spp %g" % statistics.median(r[2] for r in mine), "seconds %.2f" % statistics.median(r[3] for r in mine))
+    with open(os.path.join(opts.out, "cornell-equal-time-rounds.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["renderer", "round", "spp", "seconds", "relmse"])
+        w.writerows(rows)
 
 
 if __name__ == "__main__":
