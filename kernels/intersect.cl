@@ -6,7 +6,7 @@
 FH_INLINE void intersect_slot(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, uint p,
                               __global const float4* ray_org, __global const float4* ray_dir, __global float4* hit) {
   const float4 o = ray_org[p], d = ray_dir[p];
-  hit[p] = stored_hit(trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w, false));
+  hit[p] = stored_hit(trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w));
 }
 
 #if !defined(FH_MEGAKERNEL)  // the megakernel calls the stage function itself

@@ -220,11 +220,9 @@ FH_INLINE float4 stored_hit(TraceHit h) {
 
 // Visits the children the ray hits nearest first: returns the nearest (0 if none) and
 // pushes the others, farthest first, with their distances; among equal distances the
-// higher lane counts as nearer. Any-hit queries skip the sort (any occluder ends them, near
-// or far) and visit the highest lane first. One or two children hit, the common cases, take
-// no loop.
-FH_INLINE int order_children(float8 t_near, __global const Bvh8Node* node, int* stack_node, float* stack_t, int* sp,
-                          bool sorted) {
+// higher lane counts as nearer. One or two children hit, the common cases, take no loop.
+FH_INLINE int order_children(float8 t_near, __global const Bvh8Node* node, int* stack_node, float* stack_t,
+                             int* sp) {
   uint hits = lane_bits(t_near != (float8)(INFINITY));
   if (hits == 0) return 0;
   float t[8];
@@ -234,7 +232,7 @@ FH_INLINE int order_children(float8 t_near, __global const Bvh8Node* node, int* 
   if (hits == 0) return node->child[first];
   if ((hits & (hits - 1)) == 0) {
     const int second = lowest_bit(hits);
-    const bool swap = sorted && t[first] < t[second];
+    const bool swap = t[first] < t[second];
     const int far = swap ? second : first, near = swap ? first : second;
     stack_node[*sp] = node->child[far];
     stack_t[*sp] = t[far];
@@ -248,7 +246,7 @@ FH_INLINE int order_children(float8 t_near, __global const Bvh8Node* node, int* 
     const int i = lowest_bit(hits);
     // Insertion sort by decreasing distance.
     int j = n++;
-    while (sorted && j > 0 && t[order[j - 1]] < t[i]) {
+    while (j > 0 && t[order[j - 1]] < t[i]) {
       order[j] = order[j - 1];
       --j;
     }
@@ -262,10 +260,9 @@ FH_INLINE int order_children(float8 t_near, __global const Bvh8Node* node, int* 
   return node->child[order[n - 1]];
 }
 
-// Closest hit (any_hit == false) in [t_min, t_max), or whether there is any (any_hit ==
-// true: then only .triangle counts, >= 0 for a hit).
+// The closest hit in [t_min, t_max).
 FH_INLINE TraceHit trace_ray(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, float3 org,
-                          float3 dir, float t_min, float t_max, bool any_hit) {
+                             float3 dir, float t_min, float t_max) {
   const RayPrecomp r = precompute_ray(org, dir);
   TraceHit hit;
   hit.t = t_max;
@@ -278,15 +275,12 @@ FH_INLINE TraceHit trace_ray(__global const Bvh8Node* nodes, __global const Tria
   for (;;) {
     if (ref >= 0) {
       __global const Bvh8Node* node = nodes + ref;
-      ref = order_children(intersect_children(&r, node, hit.t), node, stack_node, stack_t, &sp, !any_hit);
+      ref = order_children(intersect_children(&r, node, hit.t), node, stack_node, stack_t, &sp);
       if (ref != 0) continue;
     } else {
       __global const TriangleBlock8* block = blocks + ~ref;
-      const int lane = intersect_block(&r, block, t_min, &hit.t, hit.triangle, &hit.b1, &hit.b2, any_hit);
-      if (lane >= 0) {
-        hit.triangle = block->id[lane];
-        if (any_hit) return hit;
-      }
+      const int lane = intersect_block(&r, block, t_min, &hit.t, hit.triangle, &hit.b1, &hit.b2, false);
+      if (lane >= 0) hit.triangle = block->id[lane];
     }
     // Pop the nearest pending child that may still hold a closer hit (or one as close with
     // a lower index: the bound is widened as the box test widens its far distance).
@@ -299,6 +293,50 @@ FH_INLINE TraceHit trace_ray(__global const Bvh8Node* nodes, __global const Tria
       }
     }
     if (ref == 0) return hit;
+  }
+}
+
+// A triangle on the segment [t_min, t_max), as its BVH-order index, or -1 if there is none
+// (shadow rays). Any occluder ends the query, near or far, and the segment never shortens, so no child needs its distance: the
+// children are visited in lane order, and a node's pending children are one stack entry,
+// the node and a bit mask of those still to visit (one entry per level, none per child).
+// Every child the segment touches is still visited until an occluder is found, so whether
+// there is one does not depend on the order (which one is found does).
+FH_INLINE int find_occluder(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, float3 org,
+                            float3 dir, float t_min, float t_max) {
+  const RayPrecomp r = precompute_ray(org, dir);
+  int stack_node[FH_TRAVERSAL_STACK];
+  uint stack_pending[FH_TRAVERSAL_STACK];
+  int sp = 0;
+  int ref = 0;  // the root
+  float t_end = t_max, b1, b2;
+  for (;;) {
+    if (ref >= 0) {
+      __global const Bvh8Node* node = nodes + ref;
+      const uint hits = lane_bits(intersect_children(&r, node, t_max) != (float8)(INFINITY));
+      if (hits != 0) {
+        const uint rest = hits & (hits - 1);
+        if (rest != 0) {
+          stack_node[sp] = ref;
+          stack_pending[sp] = rest;
+          ++sp;
+        }
+        ref = node->child[lowest_bit(hits)];
+        continue;
+      }
+    } else {
+      __global const TriangleBlock8* block = blocks + ~ref;
+      const int lane = intersect_block(&r, block, t_min, &t_end, -1, &b1, &b2, true);
+      if (lane >= 0) return block->id[lane];
+    }
+    if (sp == 0) return -1;
+    const uint pending = stack_pending[sp - 1];
+    ref = nodes[stack_node[sp - 1]].child[lowest_bit(pending)];
+    const uint rest = pending & (pending - 1);
+    if (rest != 0)
+      stack_pending[sp - 1] = rest;
+    else
+      --sp;
   }
 }
 

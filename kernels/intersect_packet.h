@@ -162,7 +162,8 @@ FH_INLINE void packet_intersect_block(const RayPacket* p, __global const Triangl
 }
 
 // Traces rays org[l] + t dir[l], t in [t_min[l], t_max[l]), for l < count (1..8), into
-// hit[l] as trace_ray would. Returns false, tracing nothing, where the rays' axis orders
+// hit[l] as trace_ray would (any-hit queries: some occluder's index, where find_occluder
+// finds one, and t_max). Returns false, tracing nothing, where the rays' axis orders
 // differ (make_packet): the caller then traces them one by one.
 FH_INLINE bool trace_packet(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, const float3* org,
                             const float3* dir, const float* t_min, const float* t_max, int count, bool any_hit,

@@ -11,7 +11,7 @@ __kernel void intersect_closest(__global const Bvh8Node* nodes, __global const T
   const uint i = get_global_id(0);
   if (i >= ray_count) return;
   const float4 o = ray_org[i], d = ray_dir[i];
-  hits[i] = stored_hit(trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w, false));
+  hits[i] = stored_hit(trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w));
 }
 
 // occluded[i] = 1 if anything lies on the segment [tmin, tmax), else 0.
@@ -21,7 +21,7 @@ __kernel void intersect_any(__global const Bvh8Node* nodes, __global const Trian
   const uint i = get_global_id(0);
   if (i >= ray_count) return;
   const float4 o = ray_org[i], d = ray_dir[i];
-  occluded[i] = trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w, true).triangle >= 0;
+  occluded[i] = find_occluder(nodes, blocks, o.xyz, d.xyz, o.w, d.w) >= 0;
 }
 
 // Rays [8 i, 8 i + 8) of the batch as a packet, or one by one where they do not share the
@@ -42,7 +42,15 @@ FH_INLINE int trace_packet_of(__global const Bvh8Node* nodes, __global const Tri
     t_max[l] = d.w;
   }
   if (!trace_packet(nodes, blocks, org, dir, t_min, t_max, count, any_hit, hit))
-    for (int l = 0; l < count; ++l) hit[l] = trace_ray(nodes, blocks, org[l], dir[l], t_min[l], t_max[l], any_hit);
+    for (int l = 0; l < count; ++l) {
+      if (any_hit) {
+        hit[l].t = t_max[l];
+        hit[l].b1 = hit[l].b2 = 0.0f;
+        hit[l].triangle = find_occluder(nodes, blocks, org[l], dir[l], t_min[l], t_max[l]);
+      } else {
+        hit[l] = trace_ray(nodes, blocks, org[l], dir[l], t_min[l], t_max[l]);
+      }
+    }
   return count;
 }
 

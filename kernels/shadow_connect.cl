@@ -140,9 +140,8 @@ FH_INLINE void connect_light(RenderParams params, const ShadowRequest* r, lmask 
 
   FH_EACH_LANE(k) {
     if (!LANE(connects, k)) continue;
-    if (trace_ray(nodes, blocks, v3_lane(origin, k), v3_lane(ls.shadow_direction, k), 0.0f,
-                  LANE(ls.shadow_distance, k), true)
-            .triangle >= 0)
+    if (find_occluder(nodes, blocks, v3_lane(origin, k), v3_lane(ls.shadow_direction, k), 0.0f,
+                      LANE(ls.shadow_distance, k)) >= 0)
       continue;
     radiance[LANE(p, k)] += (float4)(v3_lane(contribution, k), 0.0f);
   }
