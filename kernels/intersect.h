@@ -1,6 +1,7 @@
 // Ray casting against the 8-wide BVH: the watertight ray/triangle test of Woop, Benthin
-// and Wald (JCGT 2013), a conservative float8 slab test (Ize 2013), and stack traversal
-// with near-to-far child order. Used by intersect.cl and anything else that casts rays.
+// and Wald (JCGT 2013), a conservative float8 slab test (Ize 2013), and stack traversal:
+// near-to-far child order for closest hits, lane order for shadow rays (find_occluder).
+// Used by intersect.cl and anything else that casts rays.
 #ifndef FH_INTERSECT_H
 #define FH_INTERSECT_H
 
