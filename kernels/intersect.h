@@ -191,6 +191,15 @@ FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8
 // ray touches (Ize, "Robust BVH Ray Traversal", JCGT 2013).
 #define FH_SLAB_WIDEN 1.0000003576f
 
+// The slab test's near distance from the six slab distances, +INFINITY where the slabs'
+// intersection, clipped to [0, t_max], is empty. Single rays (eight children) and packets
+// (eight rays) share it, so both cull the same boxes.
+FH_INLINE float8 slab_near(float8 tx0, float8 tx1, float8 ty0, float8 ty1, float8 tz0, float8 tz1, float8 t_max) {
+  const float8 t_near = max8(max8(min8(tx0, tx1), min8(ty0, ty1)), max8(min8(tz0, tz1), (float8)(0.0f)));
+  const float8 t_far = min8(min8(max8(tx0, tx1), max8(ty0, ty1)), min8(max8(tz0, tz1), t_max)) * FH_SLAB_WIDEN;
+  return select(t_near, (float8)(INFINITY), t_near > t_far);
+}
+
 // Near distances of the eight children; lanes the ray misses get +INFINITY.
 FH_INLINE float8 intersect_children(const RayPrecomp* r, __global const Bvh8Node* node, float t_max) {
   const float8 ix = (float8)(r->inv_dir.x), iy = (float8)(r->inv_dir.y), iz = (float8)(r->inv_dir.z);
@@ -200,12 +209,8 @@ FH_INLINE float8 intersect_children(const RayPrecomp* r, __global const Bvh8Node
   const float8 ty1 = (vload8(0, node->hi_y) - (float8)(r->org_hi.y)) * iy;
   const float8 tz0 = (vload8(0, node->lo_z) - (float8)(r->org_lo.z)) * iz;
   const float8 tz1 = (vload8(0, node->hi_z) - (float8)(r->org_hi.z)) * iz;
-  const float8 t_near = max8(max8(min8(tx0, tx1), min8(ty0, ty1)), max8(min8(tz0, tz1), (float8)(0.0f)));
-  const float8 t_far = min8(min8(max8(tx0, tx1), max8(ty0, ty1)), min8(max8(tz0, tz1), (float8)(t_max))) *
-                       FH_SLAB_WIDEN;
   const int8 empty = vload8(0, node->child) == (int8)(0);
-  const int8 miss = (t_near > t_far) | empty;
-  return select(t_near, (float8)(INFINITY), miss);
+  return select(slab_near(tx0, tx1, ty0, ty1, tz0, tz1, (float8)(t_max)), (float8)(INFINITY), empty);
 }
 
 typedef struct {
@@ -298,9 +303,10 @@ FH_INLINE TraceHit trace_ray(__global const Bvh8Node* nodes, __global const Tria
 }
 
 // A triangle on the segment [t_min, t_max), as its BVH-order index, or -1 if there is none
-// (shadow rays). Any occluder ends the query, near or far, and the segment never shortens, so no child needs its distance: the
-// children are visited in lane order, and a node's pending children are one stack entry,
-// the node and a bit mask of those still to visit (one entry per level, none per child).
+// (shadow rays). Any occluder ends the query, near or far, and the segment never shortens,
+// so no child needs its distance: the children are visited in lane order, and a node's
+// pending children are one stack entry, the node and a bit mask of those still to visit
+// (one entry per level, none per child).
 // Every child the segment touches is still visited until an occluder is found, so whether
 // there is one does not depend on the order (which one is found does).
 FH_INLINE int find_occluder(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, float3 org,

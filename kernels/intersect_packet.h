@@ -91,9 +91,7 @@ FH_INLINE float8 packet_child_near(const RayPacket* p, __global const Bvh8Node* 
   const float8 ty1 = ((float8)(node->hi_y[c]) - p->org_hi_y) * p->inv_y;
   const float8 tz0 = ((float8)(node->lo_z[c]) - p->org_lo_z) * p->inv_z;
   const float8 tz1 = ((float8)(node->hi_z[c]) - p->org_hi_z) * p->inv_z;
-  const float8 t_near = max8(max8(min8(tx0, tx1), min8(ty0, ty1)), max8(min8(tz0, tz1), (float8)(0.0f)));
-  const float8 t_far = min8(min8(max8(tx0, tx1), max8(ty0, ty1)), min8(max8(tz0, tz1), t_hit)) * FH_SLAB_WIDEN;
-  return select(t_near, (float8)(INFINITY), t_near > t_far);
+  return slab_near(tx0, tx1, ty0, ty1, tz0, tz1, t_hit);
 }
 
 // Pushes the children any ray hits, farthest first (by the nearest ray's distance), and
