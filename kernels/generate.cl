@@ -11,10 +11,10 @@
 // from a shape's first sample on, every shape.pixels samples are one local pass, whose
 // global pass is in pass_table at its pass slot, and sample i of a pass renders the
 // shape's i-th listed pixel into entry j % entries of the pass buffers (pass_entry, with
-// the slot). Samples before newer.first_sample are of the older shape. Global sample
-// k = pass * pixel_count + pixel seeds the random numbers, so a sample is the same
-// whichever device renders it, and the pixel's samples are its passes' points of one
-// sequence whichever passes cover it.
+// the slot). Samples before newer.first_sample are of the older shape. The sample is point
+// pass + offset of its pixel's sequence (the listed pixel's offset, two list halves on:
+// host/render/pass_source.h), and global sample k = point * pixel_count + pixel seeds the
+// random numbers, so a sample is the same whichever device renders it.
 FH_INLINE void start_sample(RenderParams params, PassShape older, PassShape newer, uint entries, luint j, luint slot,
                             lmask active, __global const float* filter_table, __global const uint* pass_table,
                             __global const uint* pixel_list FH_PATH_PARAMS) {
@@ -24,9 +24,10 @@ FH_INLINE void start_sample(RenderParams params, PassShape older, PassShape newe
   const luint local_pass = select((luint)(older.first_pass), (luint)(newer.first_pass), is_newer) + in_shape / pixels;
   const luint pass_slot = local_pass % FH_MAX_PASS_SLOTS;
   const luint index = in_shape % pixels;
-  const luint pixel = gather_uint(pixel_list, select((luint)(older.list), (luint)(newer.list), is_newer) + index);
-  const luint pass = gather_uint(pass_table, pass_slot);
-  const luint k = pass * params.pixel_count + pixel;
+  const luint listed = select((luint)(older.list), (luint)(newer.list), is_newer) + index;
+  const luint pixel = gather_uint(pixel_list, listed);
+  const luint point = gather_uint(pass_table, pass_slot) + gather_uint(pixel_list, listed + 2u * params.pixel_count);
+  const luint k = point * params.pixel_count + pixel;
   const PixelSampler sampler = pixel_sampler(params.seed, k, params.pixel_count, params.replicates);
   const lvec2 u = sample_2d(&sampler, (luint)(FH_DIM_PIXEL));
   const uint width = (uint)params.camera.width;

@@ -14,7 +14,7 @@
   X(float4, throughput, 16)     /* rgb (w unused: 16-byte loads) */                              \
   X(float, ray_pdf, 4)          /* pdf with which the BSDF sampled ray_dir (MIS); < 0: delta */ \
   X(float4, radiance, 16)       /* rgb gathered so far */                                        \
-  X(uint, sample_id, 4)         /* global sample index: pixel = id % pixels, pass = id / pixels */ \
+  X(uint, sample_id, 4)         /* global sample index: pixel = id % pixels, its point = id / pixels */ \
   X(uint, pass_entry, 4)        /* entry in the pass buffers and pass slot: FH_PASS_ENTRY */     \
   X(uint, depth, 4)             /* bounces so far */
 

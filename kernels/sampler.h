@@ -48,23 +48,24 @@ FH_INLINE luint sobol_second_dimension_reversed(luint j) {
   return j;
 }
 
-// One sample of one pixel: the pixel's scrambling seed and the sample's index (its pass)
-// with the bits reversed, as the index shuffle takes it.
+// One sample of one pixel: the pixel's scrambling seed and the sample's index in the pixel's
+// sequence (its point) with the bits reversed, as the index shuffle takes it.
 typedef struct {
   luint pixel_seed;
   luint index_reversed;
 } PixelSampler;
 
-// With replicates == 2 (a noise target: host/render/film.h), a pixel's even and odd passes
+// With replicates == 2 (a noise target: host/render/film.h), a pixel's even and odd points
 // are two sequences under independent scramblings, each a net in its own right: the
 // difference of their means is an unbiased estimate of the image's error, which the
-// correlated points of one sequence do not give. replicates == 1: one sequence.
+// correlated points of one sequence do not give. replicates == 1: one sequence. (A point's
+// parity is its pass's, by which the film sorts: sequence offsets are even.)
 FH_INLINE PixelSampler pixel_sampler(uint seed, luint sample_id, uint pixel_count, uint replicates) {
   PixelSampler s;
-  const luint pass = sample_id / pixel_count, shift = (luint)(replicates - 1u);
-  const luint replicate = pass & shift;
+  const luint point = sample_id / pixel_count, shift = (luint)(replicates - 1u);
+  const luint replicate = point & shift;
   s.pixel_seed = hash_combine((luint)(seed) + replicate * 0x9e3779b9u, sample_id % pixel_count);
-  s.index_reversed = reverse_bits_u32(pass >> shift);
+  s.index_reversed = reverse_bits_u32(point >> shift);
   return s;
 }
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -238,6 +239,37 @@ TEST(AdaptiveCli, TheImageForASeedIsTheSameOnEveryDeviceAndWavefront) {
   EXPECT_TRUE(readImage(dir + "/two.exr").rgb == one.rgb);
   EXPECT_TRUE(readImage(dir + "/small.exr").rgb == one.rgb);
   EXPECT_EQ(layer(dir + "/two.exr", "spp.Y"), layer(dir + "/one.exr", "spp.Y"));
+}
+
+// A pixel's samples are the first points of its sequence, however many rounds passed it by
+// (render/pass_source.h, RoundPixels): where the adaptive render gave a pixel n samples, its
+// value is the same bits as a uniform render's of n samples per pixel (the same seed: the
+// same points, and the film's sums do not depend on the order). Checked for the three
+// counts above the first round's that most pixels have.
+TEST(AdaptiveCli, EachPixelsSamplesAreTheFirstPointsOfItsSequence) {
+  const std::string dir = test::tempDir("adaptive-prefix");
+  ASSERT_EQ(test::runFredholm(kAdaptive + " -o " + dir + "/a.exr").exitCode, 0);
+  const Image adaptive = readImage(dir + "/a.exr");
+  const std::vector<float> spp = layer(dir + "/a.exr", "spp.Y");
+  std::map<int, int> pixelsWith;
+  for (float n : spp)
+    if (n > float(kAdaptiveFirstRound)) ++pixelsWith[int(n)];
+  std::vector<std::pair<int, int>> common;  // (pixels, count), most pixels first
+  for (const auto& [count, pixels] : pixelsWith) common.push_back({pixels, count});
+  std::sort(common.rbegin(), common.rend());
+  ASSERT_GE(common.size(), 3u) << "the rounds gave pixels a few different counts";
+  for (size_t i = 0; i < 3; ++i) {
+    const int count = common[i].second;
+    const std::string out = dir + "/u" + std::to_string(count) + ".exr";
+    ASSERT_EQ(test::runFredholm("render " + test::projectScene("failure/caustic.obj") + " --width 32 --height 32 --spp " +
+                                std::to_string(count) + " --seed 5 -o " + out).exitCode, 0);
+    const Image uniform = readImage(out);
+    int differ = 0;
+    for (size_t p = 0; p < spp.size(); ++p)
+      if (int(spp[p]) == count)
+        for (size_t c = 0; c < 3; ++c) differ += adaptive.rgb[3 * p + c] != uniform.rgb[3 * p + c];
+    EXPECT_EQ(differ, 0) << "of the " << common[i].first << " pixels with " << count << " samples";
+  }
 }
 
 // Killed at the start of a round, in the first round and in later ones, and resumed: the

@@ -10,8 +10,11 @@
 // Rounds are fixed runs of passes: [0, 16) over every pixel, then runs of 16 passes up to
 // pass 64, then runs half as long as the passes before them (64:96, 96:128, 128:192,
 // 192:256), then of 64 (a pixel a round takes in gets no more than 64 samples at once).
-// Each is a power of two long and starts at a multiple of its length, so a pixel's samples
-// are whole aligned blocks of its low-discrepancy sequence, each block stratified.
+// Each is a power of two long and starts at a multiple of its length. A pixel's samples are
+// the first points of its low-discrepancy sequence, as many as it got (the round's sequence
+// offsets, render/pass_source.h), so its counts at the ends of rounds are nets where it
+// matters most: not the points of the passes that covered it, which are scattered blocks of
+// the sequence (whose union is stratified no better than its blocks).
 //
 // A round's pixels are chosen from the film once it holds the first half of the round
 // before it, counting the samples the rest of that round adds (the second round's, once it

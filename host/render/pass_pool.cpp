@@ -167,7 +167,7 @@ Film PassPool::finish(bool& complete) {
   for (auto& [pass, samples] : pending_) {
     if (noiseReached_) break;  // beyond the pass that met the target
     const Round& round = *roundOf(pass);
-    film_.addPass(pass, samples, round.pixels.get());
+    film_.addPass(pass, samples, round.pixels ? &round.pixels->pixels : nullptr);
     mergedSamples_ += double(round.size);
   }
   pending_.clear();
@@ -180,7 +180,43 @@ Film PassPool::finish(bool& complete) {
 void PassPool::addRound(uint32_t begin, std::shared_ptr<const PixelList> pixels) {
   if (pixels && pixels->size() == film_.pixels()) pixels = nullptr;
   const size_t size = pixels ? pixels->size() : film_.pixels();
-  rounds_.push_back({begin, settings_.adaptive ? adaptiveRoundEnd(begin) : total_, std::move(pixels), size});
+  std::shared_ptr<const RoundPixels> round;
+  if (settings_.adaptive) {
+    std::vector<uint32_t> offsets = sequenceOffsets(begin, pixels.get());
+    if (pixels || std::any_of(offsets.begin(), offsets.end(), [](uint32_t o) { return o != 0; }))
+      round = std::make_shared<const RoundPixels>(
+          RoundPixels{pixels ? *pixels : everyPixel(film_.pixels()), std::move(offsets)});
+  }
+  rounds_.push_back({begin, settings_.adaptive ? adaptiveRoundEnd(begin) : total_, std::move(round), size});
+}
+
+// Where each pixel listed (null: every pixel) is in its sequence when the round from pass
+// `begin` on starts: its sample count then, less `begin`. The film holds the passes before
+// its nextPass(); the rounds known between it and `begin` add theirs, and a round the film
+// is already into (a resumed render's) takes its own off. The counts are whole rounds'
+// lengths, which are even, so a point's parity is its pass's (kernels/sampler.h).
+std::vector<uint32_t> PassPool::sequenceOffsets(uint32_t begin, const PixelList* pixels) const {
+  std::vector<double> counts(film_.pixels());
+  for (size_t p = 0; p < counts.size(); ++p) counts[p] = film_.count(p);
+  const auto add = [&](const PixelList* list, double passes) {
+    if (!list)
+      for (double& c : counts) c += passes;
+    else
+      for (uint32_t p : *list) counts[p] += passes;
+  };
+  const uint32_t held = uint32_t(film_.nextPass());
+  if (held > begin) add(pixels, -double(held - begin));
+  for (const Round& r : rounds_) {
+    const uint32_t from = std::max(r.begin, held), to = std::min(r.end, begin);
+    if (from < to) add(r.pixels ? &r.pixels->pixels : nullptr, double(to - from));
+  }
+  std::vector<uint32_t> offsets;
+  const auto offset = [&](uint32_t p) { offsets.push_back(uint32_t(counts[p]) - begin); };
+  if (!pixels)
+    for (uint32_t p = 0; p < counts.size(); ++p) offset(p);
+  else
+    for (uint32_t p : *pixels) offset(p);
+  return offsets;
 }
 
 const PassPool::Round* PassPool::roundOf(uint32_t pass) const {
@@ -194,7 +230,8 @@ const PassPool::Round* PassPool::roundOf(uint32_t pass) const {
 // adding rounds).
 std::shared_ptr<const PixelList> PassPool::pixelsOfRoundAfter(uint32_t begin) const {
   const Round& round = *roundOf(begin);
-  return adaptivePixels(film_, round.end, round.pixels.get(), round.end - adaptiveChoicePoint(begin));
+  return adaptivePixels(film_, round.end, round.pixels ? &round.pixels->pixels : nullptr,
+                        round.end - adaptiveChoicePoint(begin));
 }
 
 // What a checkpoint of the film needs to go on: the pixels of the round its next pass is
@@ -203,7 +240,7 @@ std::shared_ptr<const PixelList> PassPool::pixelsOfRoundAfter(uint32_t begin) co
 void PassPool::recordRounds() {
   const auto listed = [&](const Round* r) -> std::shared_ptr<const PixelList> {
     if (!r || r->begin < kAdaptiveFirstRound) return nullptr;
-    if (r->pixels) return r->pixels;
+    if (r->pixels) return std::shared_ptr<const PixelList>(r->pixels, &r->pixels->pixels);
     if (!everyPixel_) everyPixel_ = std::make_shared<const PixelList>(everyPixel(film_.pixels()));
     return everyPixel_;
   };
@@ -235,7 +272,7 @@ void PassPool::mergeInOrder() {
     pending_.erase(next);
     const Round round = *roundOf(pass);  // the merger alone adds and drops rounds
     lock.unlock();
-    film_.addPass(pass, samples, round.pixels.get());
+    film_.addPass(pass, samples, round.pixels ? &round.pixels->pixels : nullptr);
     const bool check = settings_.noise > 0.0 && film_.passes() >= kNoiseMinPasses;
     const double estimate = check ? film_.estimatedRelMse() : -1.0;
     if (settings_.ledger) settings_.ledger->finished(pass);

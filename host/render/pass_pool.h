@@ -57,10 +57,11 @@ class PassPool : public PassSource {
   // Runs of passes over the same pixels: every pass of a render but an adaptive one's in one.
   struct Round {
     uint32_t begin = 0, end = 0;
-    std::shared_ptr<const PixelList> pixels;  // null: every pixel
-    size_t size = 0;                          // pixels covered
+    std::shared_ptr<const RoundPixels> pixels;  // null: every pixel, from its pass's point on
+    size_t size = 0;                            // pixels covered
   };
   void addRound(uint32_t begin, std::shared_ptr<const PixelList> pixels);
+  std::vector<uint32_t> sequenceOffsets(uint32_t begin, const PixelList* pixels) const;
   const Round* roundOf(uint32_t pass) const;  // null: its pixels are not chosen yet
   std::shared_ptr<const PixelList> pixelsOfRoundAfter(uint32_t begin) const;
   void recordRounds();

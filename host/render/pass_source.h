@@ -21,9 +21,19 @@ inline PixelList everyPixel(size_t pixels) {
   return list;
 }
 
+// The pixels a round's passes cover (render/adaptive.h) and where each one's samples are in
+// its own sequence: pass k's sample of listed pixel i is point k + offsets[i] (mod 2^32) of
+// that pixel's sequence. An adaptive render sets the offsets so that every pixel's samples
+// are the first points of its sequence, however many rounds passed it by: the first 2^m
+// points of a low-discrepancy sequence are a net, points from scattered blocks of it are not.
+struct RoundPixels {
+  PixelList pixels;
+  std::vector<uint32_t> offsets;  // one per listed pixel
+};
+
 struct Pass {
   uint32_t index = 0;
-  std::shared_ptr<const PixelList> pixels;  // null: every pixel
+  std::shared_ptr<const RoundPixels> pixels;  // null: every pixel, its sample k point k
 };
 
 class PassSource {

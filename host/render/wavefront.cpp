@@ -135,7 +135,9 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
                 " is more than 2^32 samples in one render; render fewer");
   passes_.assign(FH_MAX_PASS_SLOTS, {});
   everyPixel_ = everyPixel(pixels_);
+  noOffsets_.assign(pixels_, 0u);
   lists_ = {everyPixel_, {}};
+  offsets_ = {noOffsets_, {}};
   shapes_[0] = shapes_[1] = {pixels_, 0, 0, 0};  // every pixel, listed in the first half
   std::copy(shapes_.begin(), shapes_.end(), counters_.shapes);
   counters_.pass_entries = uint32_t(passEntries_);
@@ -179,7 +181,8 @@ void WavefrontPipeline::allocateBuffers(const std::vector<float>& filterTable) {
   filterTable_ = allocateBuffer(dc_.context, dc_.info.device, CL_MEM_READ_ONLY, filterTable.size() * 4,
                                 "filter table", filterTable.data());
   passTableBuffer_ = buffer(FH_MAX_PASS_SLOTS * 4, "pass table");
-  std::vector<uint32_t> lists(2 * size_t(pixels_));  // each shape's list in a half of its own
+  // Each shape's list in a half of its own, then each one's sequence offsets (zero here).
+  std::vector<uint32_t> lists(4 * size_t(pixels_), 0u);
   std::copy(everyPixel_.begin(), everyPixel_.end(), lists.begin());
   pixelListBuffer_ = buffer(lists.size() * 4, "pixel lists", lists.data());
 }
@@ -250,10 +253,10 @@ void WavefrontPipeline::writeCounter(size_t offset, const uint32_t& value) {
   FH_CL(dc_.queue.enqueueWriteBuffer(queues_.counters, CL_FALSE, offset, 4, &value));
 }
 
-bool WavefrontPipeline::fits(const std::shared_ptr<const PixelList>& pixels, uint64_t granted,
+bool WavefrontPipeline::fits(const std::shared_ptr<const RoundPixels>& pixels, uint64_t granted,
                              uint64_t returned) const {
   if (granted - returned >= FH_MAX_PASS_SLOTS) return false;
-  const uint32_t size = pixels ? uint32_t(pixels->size()) : pixels_;
+  const uint32_t size = pixels ? uint32_t(pixels->pixels.size()) : pixels_;
   // The pass buffers are a ring of entries in local sample order, from the oldest pass's.
   const uint32_t oldest = granted == returned ? grantedSamples_ : passes_[returned % FH_MAX_PASS_SLOTS].firstSample;
   if (size_t(grantedSamples_ - oldest) + size > passEntries_) return false;
@@ -262,7 +265,7 @@ bool WavefrontPipeline::fits(const std::shared_ptr<const PixelList>& pixels, uin
   return pixels == shapePixels_[1] || counters_.next_sample >= shapes_[1].first_sample;
 }
 
-void WavefrontPipeline::grantPass(uint64_t local, uint32_t global, std::shared_ptr<const PixelList> pixels) {
+void WavefrontPipeline::grantPass(uint64_t local, uint32_t global, std::shared_ptr<const RoundPixels> pixels) {
   if (pixels != shapePixels_[1]) newShape(std::move(pixels), local);
   const size_t slot = size_t(local % FH_MAX_PASS_SLOTS);  // free: its last pass was returned
   passes_[slot] = {global, grantedSamples_, shapes_[1].pixels};
@@ -272,17 +275,22 @@ void WavefrontPipeline::grantPass(uint64_t local, uint32_t global, std::shared_p
 
 // The newer shape becomes the older, and local pass `local` on is of the new one, whose
 // pixel list takes the half of the pixel-list buffer the older's older had.
-void WavefrontPipeline::newShape(std::shared_ptr<const PixelList> pixels, uint64_t local) {
-  const std::vector<uint32_t>& list = pixels ? *pixels : everyPixel_;
-  if (list.empty() || list.size() > pixels_) throw Error("internal: a pass of no pixels, or of too many");
+void WavefrontPipeline::newShape(std::shared_ptr<const RoundPixels> pixels, uint64_t local) {
+  const std::vector<uint32_t>& list = pixels ? pixels->pixels : everyPixel_;
+  const std::vector<uint32_t>& offsets = pixels ? pixels->offsets : noOffsets_;
+  if (list.empty() || list.size() > pixels_ || offsets.size() != list.size())
+    throw Error("internal: a pass of no pixels, or of too many");
   const size_t half = shapes_[1].list == 0 ? 1 : 0;
-  lists_[half] = list;  // stable storage for the write
+  lists_[half] = list;  // stable storage for the writes
+  offsets_[half] = offsets;
   shapes_[0] = shapes_[1];
   shapes_[1] = {uint32_t(list.size()), grantedSamples_, uint32_t(local), uint32_t(half * pixels_)};
   shapePixels_[0] = std::move(shapePixels_[1]);
   shapePixels_[1] = std::move(pixels);
   FH_CL(dc_.queue.enqueueWriteBuffer(pixelListBuffer_, CL_FALSE, half * pixels_ * 4, list.size() * 4,
                                      lists_[half].data()));
+  FH_CL(dc_.queue.enqueueWriteBuffer(pixelListBuffer_, CL_FALSE, (2 + half) * pixels_ * 4, list.size() * 4,
+                                     offsets_[half].data()));
   FH_CL(dc_.queue.enqueueWriteBuffer(queues_.counters, CL_FALSE, offsetof(gpu::WavefrontCounters, shapes),
                                      sizeof shapes_, shapes_.data()));
 }

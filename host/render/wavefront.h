@@ -75,12 +75,13 @@ class WavefrontPipeline {
   void enqueueIteration();
 
   // Passes are numbered locally (0, 1, ... on this device) and mapped to global passes,
-  // which seed the samples. A pass covers the pixels listed (null: every pixel). Passes
+  // which seed the samples. A pass covers the pixels listed (null: every pixel, each
+  // pixel's sample of pass k its sequence's point k). Passes
   // are granted while they fit: FH_MAX_PASS_SLOTS unfinished at most, their samples within
   // the pass buffers, and of two shapes at most: a pass of a new shape waits until every
   // sample of the older one in flight has started.
-  bool fits(const std::shared_ptr<const PixelList>& pixels, uint64_t granted, uint64_t returned) const;
-  void grantPass(uint64_t local, uint32_t global, std::shared_ptr<const PixelList> pixels);
+  bool fits(const std::shared_ptr<const RoundPixels>& pixels, uint64_t granted, uint64_t returned) const;
+  void grantPass(uint64_t local, uint32_t global, std::shared_ptr<const RoundPixels> pixels);
   // Lets the passes granted so far start; once per batch, after its grants.
   void startGrantedPasses();
   uint32_t globalPass(uint64_t local) const { return passes_[local % FH_MAX_PASS_SLOTS].global; }
@@ -118,7 +119,7 @@ class WavefrontPipeline {
   void bindArguments(unsigned parity);
   bool launches(Stage s) const;  // whether this strategy launches the stage's own kernel
   void writeCounter(size_t offset, const uint32_t& value);
-  void newShape(std::shared_ptr<const PixelList> pixels, uint64_t local);
+  void newShape(std::shared_ptr<const RoundPixels> pixels, uint64_t local);
 
   DeviceContext& dc_;
   Method method_;
@@ -144,12 +145,12 @@ class WavefrontPipeline {
   uint32_t grantedSamples_ = 0;  // local samples of the passes granted so far
   uint32_t sampleLimit_ = 0;     // what the device may start: stable storage for writes
   // The two shapes of WavefrontCounters (stable storage for writes) and the pixel lists
-  // they cover (null: every pixel, listed in everyPixel_); a shape's list is in the half
-  // of the pixel-list buffer at its `list`.
+  // they cover (null: every pixel, listed in everyPixel_, offsets 0); a shape's list is in
+  // the half of the pixel-list buffer at its `list`, its sequence offsets two halves on.
   std::array<gpu::PassShape, 2> shapes_{};
-  std::array<std::shared_ptr<const PixelList>, 2> shapePixels_;
-  std::array<std::vector<uint32_t>, 2> lists_;  // each half's list (stable storage for writes)
-  std::vector<uint32_t> everyPixel_;
+  std::array<std::shared_ptr<const RoundPixels>, 2> shapePixels_;
+  std::array<std::vector<uint32_t>, 2> lists_, offsets_;  // each half's (stable storage for writes)
+  std::vector<uint32_t> everyPixel_, noOffsets_;
   gpu::WavefrontCounters counters_{};
   // Every stage's kernel twice, bound once for each parity: an iteration sets nothing.
   std::array<std::array<cl::Kernel, kStages.size()>, 2> kernels_;
