@@ -167,7 +167,7 @@ Film PassPool::finish(bool& complete) {
   for (auto& [pass, samples] : pending_) {
     if (noiseReached_) break;  // beyond the pass that met the target
     const Round& round = *roundOf(pass);
-    film_.addPass(pass, samples, round.pixels ? &round.pixels->pixels : nullptr);
+    film_.addPass(pass, samples, round.list());
     mergedSamples_ += double(round.size);
   }
   pending_.clear();
@@ -208,7 +208,7 @@ std::vector<uint32_t> PassPool::sequenceOffsets(uint32_t begin, const PixelList*
   if (held > begin) add(pixels, -double(held - begin));
   for (const Round& r : rounds_) {
     const uint32_t from = std::max(r.begin, held), to = std::min(r.end, begin);
-    if (from < to) add(r.pixels ? &r.pixels->pixels : nullptr, double(to - from));
+    if (from < to) add(r.list(), double(to - from));
   }
   std::vector<uint32_t> offsets;
   const auto offset = [&](uint32_t p) { offsets.push_back(uint32_t(counts[p]) - begin); };
@@ -230,8 +230,7 @@ const PassPool::Round* PassPool::roundOf(uint32_t pass) const {
 // adding rounds).
 std::shared_ptr<const PixelList> PassPool::pixelsOfRoundAfter(uint32_t begin) const {
   const Round& round = *roundOf(begin);
-  return adaptivePixels(film_, round.end, round.pixels ? &round.pixels->pixels : nullptr,
-                        round.end - adaptiveChoicePoint(begin));
+  return adaptivePixels(film_, round.end, round.list(), round.end - adaptiveChoicePoint(begin));
 }
 
 // What a checkpoint of the film needs to go on: the pixels of the round its next pass is
@@ -272,7 +271,7 @@ void PassPool::mergeInOrder() {
     pending_.erase(next);
     const Round round = *roundOf(pass);  // the merger alone adds and drops rounds
     lock.unlock();
-    film_.addPass(pass, samples, round.pixels ? &round.pixels->pixels : nullptr);
+    film_.addPass(pass, samples, round.list());
     const bool check = settings_.noise > 0.0 && film_.passes() >= kNoiseMinPasses;
     const double estimate = check ? film_.estimatedRelMse() : -1.0;
     if (settings_.ledger) settings_.ledger->finished(pass);

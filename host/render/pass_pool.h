@@ -59,6 +59,7 @@ class PassPool : public PassSource {
     uint32_t begin = 0, end = 0;
     std::shared_ptr<const RoundPixels> pixels;  // null: every pixel, from its pass's point on
     size_t size = 0;                            // pixels covered
+    const PixelList* list() const { return pixels ? &pixels->pixels : nullptr; }  // null: every pixel
   };
   void addRound(uint32_t begin, std::shared_ptr<const PixelList> pixels);
   std::vector<uint32_t> sequenceOffsets(uint32_t begin, const PixelList* pixels) const;

@@ -279,7 +279,7 @@ void WavefrontPipeline::newShape(std::shared_ptr<const RoundPixels> pixels, uint
   const std::vector<uint32_t>& list = pixels ? pixels->pixels : everyPixel_;
   const std::vector<uint32_t>& offsets = pixels ? pixels->offsets : noOffsets_;
   if (list.empty() || list.size() > pixels_ || offsets.size() != list.size())
-    throw Error("internal: a pass of no pixels, or of too many");
+    throw Error("internal: a pass of no pixels, of too many, or without an offset for each");
   const size_t half = shapes_[1].list == 0 ? 1 : 0;
   lists_[half] = list;  // stable storage for the writes
   offsets_[half] = offsets;
