@@ -46,8 +46,14 @@ FH_INLINE int lowest_bit(uint m) { return 31 - (int)clz(m & (0u - m)); }
 // Per-ray constants of the watertight test: the axis the ray is most aligned with
 // (kz), the shear that maps the ray onto +z, and the origin in that axis order.
 typedef struct {
-  float3 org_lo, org_hi;  // the origin as the slab test meets boxes' low and high faces
   float3 inv_dir;
+  // Per axis, which of a node's two planes the ray enters by (its offset in floats in
+  // Bvh8Node: the low plane where the direction is positive) and the origin as that plane
+  // meets it; the exit plane is the other (offset ^ 8; kernel_layouts.cpp pins the
+  // offsets). Chosen once per ray, so a box test needs no min and max to sort each axis'
+  // two distances.
+  int near_x, near_y, near_z;
+  float3 org_near, org_far;  // the origin as the slab test meets the entry and exit planes
   int kx, ky, kz;
   float sx, sy, sz;
   float ox, oy, oz;  // origin components along kx, ky, kz
@@ -83,8 +89,13 @@ FH_INLINE RayPrecomp precompute_ray(float3 org, float3 dir) {
   const int3 flat = fabs(dir) < (float3)(tiny);
   const float3 eps = fmax(fabs(org), (float3)(1.0f)) * 0x1p-20f;
   r.inv_dir = 1.0f / select(dir, (float3)(tiny), flat);
-  r.org_lo = select(org, org + eps, flat);
-  r.org_hi = select(org, org - eps, flat);
+  const float3 org_lo = select(org, org + eps, flat), org_hi = select(org, org - eps, flat);
+  const int3 forward = r.inv_dir >= (float3)(0.0f);
+  r.near_x = forward.x ? 0 : 8;
+  r.near_y = forward.y ? 16 : 24;
+  r.near_z = forward.z ? 32 : 40;
+  r.org_near = select(org_hi, org_lo, forward);
+  r.org_far = select(org_lo, org_hi, forward);
   return r;
 }
 
@@ -200,17 +211,22 @@ FH_INLINE float8 slab_near(float8 tx0, float8 tx1, float8 ty0, float8 ty1, float
   return select(t_near, (float8)(INFINITY), t_near > t_far);
 }
 
-// Near distances of the eight children; lanes the ray misses get +INFINITY.
+// Near distances of the eight children; lanes the ray misses get +INFINITY. Each axis'
+// entry and exit distances are the two the slab test would sort into its min and max
+// (the same bits: a positive inverse keeps low before high, a negative one swaps them).
 FH_INLINE float8 intersect_children(const RayPrecomp* r, __global const Bvh8Node* node, float t_max) {
+  __global const float* planes = (__global const float*)node;
   const float8 ix = (float8)(r->inv_dir.x), iy = (float8)(r->inv_dir.y), iz = (float8)(r->inv_dir.z);
-  const float8 tx0 = (vload8(0, node->lo_x) - (float8)(r->org_lo.x)) * ix;
-  const float8 tx1 = (vload8(0, node->hi_x) - (float8)(r->org_hi.x)) * ix;
-  const float8 ty0 = (vload8(0, node->lo_y) - (float8)(r->org_lo.y)) * iy;
-  const float8 ty1 = (vload8(0, node->hi_y) - (float8)(r->org_hi.y)) * iy;
-  const float8 tz0 = (vload8(0, node->lo_z) - (float8)(r->org_lo.z)) * iz;
-  const float8 tz1 = (vload8(0, node->hi_z) - (float8)(r->org_hi.z)) * iz;
-  const int8 empty = vload8(0, node->child) == (int8)(0);
-  return select(slab_near(tx0, tx1, ty0, ty1, tz0, tz1, (float8)(t_max)), (float8)(INFINITY), empty);
+  const float8 nx = (vload8(0, planes + r->near_x) - (float8)(r->org_near.x)) * ix;
+  const float8 fx = (vload8(0, planes + (r->near_x ^ 8)) - (float8)(r->org_far.x)) * ix;
+  const float8 ny = (vload8(0, planes + r->near_y) - (float8)(r->org_near.y)) * iy;
+  const float8 fy = (vload8(0, planes + (r->near_y ^ 8)) - (float8)(r->org_far.y)) * iy;
+  const float8 nz = (vload8(0, planes + r->near_z) - (float8)(r->org_near.z)) * iz;
+  const float8 fz = (vload8(0, planes + (r->near_z ^ 8)) - (float8)(r->org_far.z)) * iz;
+  const float8 t_near = max8(max8(nx, ny), max8(nz, (float8)(0.0f)));
+  const float8 t_far = min8(min8(fx, fy), min8(fz, (float8)(t_max))) * FH_SLAB_WIDEN;
+  const int8 missed = (t_near > t_far) | (vload8(0, node->child) == (int8)(0));
+  return select(t_near, (float8)(INFINITY), missed);
 }
 
 typedef struct {
