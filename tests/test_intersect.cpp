@@ -16,6 +16,7 @@
 #include <cstring>
 #include <future>
 #include <random>
+#include <set>
 
 #include "accel/bvh.h"
 #include "base/vec.h"
@@ -396,6 +397,47 @@ TEST(BvhBuild, TheSameTreeOnAnyNumberOfThreads) {
   // once, and below testing them all.
   EXPECT_GT(serial.stats.sahCost, 1.0);
   EXPECT_LT(serial.stats.sahCost, 0.15 * double(scene.triangleCount()));
+}
+
+// The 8-wide tree is planned by dynamic programming over the binary tree (bvh.cpp,
+// WideCollapser). The tree it emits must be the plan it costed: its cost, recomputed from
+// the nodes' child boxes (a wide node visit 1, a leaf block 1.2, by area over the root's),
+// is the cost the build reports. Each leaf block holds each triangle once, and every
+// triangle is in some block.
+TEST(BvhBuild, TheWideTreeIsThePlanItCosted) {
+  for (const char* file : {"blob/CornellBox-Blob.obj", "colonnade/colonnade.obj"}) {
+    const Scene scene = loadScene(test::testScene(file));
+    const Bvh bvh = buildBvh(scene);
+    auto area = [](const gpu::Bvh8Node& n, int i) {
+      const double x = double(n.hi_x[i]) - n.lo_x[i], y = double(n.hi_y[i]) - n.lo_y[i],
+                   z = double(n.hi_z[i]) - n.lo_z[i];
+      return 2.0 * (x * y + y * z + z * x);
+    };
+    gpu::Bvh8Node root = bvh.nodes[0];
+    for (int i = 1; i < 8; ++i) {
+      if (root.child[i] == 0) continue;
+      root.lo_x[0] = std::min(root.lo_x[0], root.lo_x[i]), root.hi_x[0] = std::max(root.hi_x[0], root.hi_x[i]);
+      root.lo_y[0] = std::min(root.lo_y[0], root.lo_y[i]), root.hi_y[0] = std::max(root.hi_y[0], root.hi_y[i]);
+      root.lo_z[0] = std::min(root.lo_z[0], root.lo_z[i]), root.hi_z[0] = std::max(root.hi_z[0], root.hi_z[i]);
+    }
+    const double rootArea = area(root, 0);
+    double cost = 1.0;
+    for (const gpu::Bvh8Node& n : bvh.nodes)
+      for (int i = 0; i < 8; ++i)
+        if (n.child[i] != 0) cost += (n.child[i] > 0 ? 1.0 : 1.2) * area(n, i) / rootArea;
+    EXPECT_NEAR(cost, bvh.stats.wideSahCost, 1e-4 * cost) << file;
+
+    std::vector<int> blocksHolding(scene.triangleCount(), 0);
+    for (const gpu::TriangleBlock8& b : bvh.blocks) {
+      std::set<int> ids;
+      for (int lane = 0; lane < 8; ++lane)
+        if (b.id[lane] >= 0) {
+          EXPECT_TRUE(ids.insert(b.id[lane]).second) << file << ": triangle " << b.id[lane] << " twice in a block";
+          ++blocksHolding[size_t(b.id[lane])];
+        }
+    }
+    EXPECT_EQ(std::count(blocksHolding.begin(), blocksHolding.end(), 0), 0) << file;
+  }
 }
 
 // Spatial splits cut the long, overlapping triangles of a Sponza-like scene: the tree holds

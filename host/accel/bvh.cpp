@@ -24,6 +24,9 @@ constexpr unsigned kMaxLeaf = FH_MAX_LEAF_TRIANGLES;
 // (TriangleBlock8), so a triangle costs a fraction of a box test and leaves fill up.
 constexpr float kTraversalCost = 1.0f;
 constexpr float kTriangleCost = 0.15f;
+// Testing a leaf block costs the same however many of its eight lanes are filled
+// (WideCollapser chooses the 8-wide tree with it).
+constexpr float kLeafBlockCost = kTriangleCost * float(kMaxLeaf);
 // Spatial splits are tried where the best object split's children overlap by more than
 // this fraction of the root's area (Stich et al.'s alpha, who use 1e-5): below it they gain
 // little, and trying them costs a clipping pass over the node's references.
@@ -413,6 +416,14 @@ double sahCost(const std::vector<BinaryNode>& nodes) {
   return cost;
 }
 
+// The 8-wide tree, chosen by dynamic programming over the binary tree (Ylitie, Karras and
+// Laine, "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", HPG
+// 2017). For every binary node and every number of slots i (1 to 8) it finds the cheapest
+// way, by the SAH, to hang the node's subtree from at most i slots of a wide node, where a
+// slot holds a wide node of its own or a leaf block, and a block may gather the triangles
+// of several binary leaves (up to eight references). Opening the largest child greedily,
+// as before, left many wide nodes with two or three children whose leaves their parent
+// could have held, and so more levels to visit.
 class WideCollapser {
  public:
   // bvhIndex[t]: file-order triangle t's index in BVH order, the id its leaves' lanes hold.
@@ -420,31 +431,125 @@ class WideCollapser {
       : binary_(binary.nodes), leafTriangles_(binary.leafTriangles), scene_(scene), bvhIndex_(bvhIndex), out_(out) {}
 
   void collapseRoot() {
+    plan_.resize(binary_.size());
+    planSubtrees();
+    out_.stats.wideSahCost = kTraversalCost + plan_[0].cost[kWidth - 1];
     if (binary_[0].count > 0) {
       // A single-leaf tree still gets an inner root, so the root is never a leaf.
       out_.nodes.emplace_back();
       clearNode(out_.nodes[0]);
       setChild(0, 0, 0, 1);
-      out_.stats.depth = 1;
-      out_.stats.leaves = 1;
       return;
     }
-    collapse(0, 1);
+    addWideNode(0, 1);
   }
 
  private:
+  static constexpr int kWidth = FH_BVH_WIDTH;
+
+  // The cheapest plans for one binary node's subtree.
+  struct SlotPlan {
+    float cost[kWidth];  // cost[i - 1]: in at most i slots, relative to the root's area
+    // leftSlots[i - 1] (i >= 2, inner nodes): how many of the i slots the left child's plan
+    // gets; the right child's gets the rest.
+    unsigned char leftSlots[kWidth];
+    bool asLeaf;  // in one slot: a leaf block, not a wide node
+    unsigned references;  // in the subtree's leaves
+  };
+
+  float leafCost(float area, unsigned references) const {
+    return references <= kMaxLeaf ? area * kLeafBlockCost : INFINITY;
+  }
+
+  // Children before parents would need the builder's numbering; an explicit post-order
+  // does not.
+  void planSubtrees() {
+    const float rootArea = std::max(binary_[0].box.area(), 1e-30f);
+    std::vector<std::pair<int, bool>> stack = {{0, false}};
+    while (!stack.empty()) {
+      const auto [b, childrenDone] = stack.back();
+      stack.pop_back();
+      const BinaryNode& n = binary_[size_t(b)];
+      if (n.count == 0 && !childrenDone) {
+        stack.push_back({b, true});
+        stack.push_back({n.left, false});
+        stack.push_back({n.right, false});
+        continue;
+      }
+      planNode(b, n.box.area() / rootArea);
+    }
+  }
+
+  void planNode(int b, float area) {
+    const BinaryNode& n = binary_[size_t(b)];
+    SlotPlan& p = plan_[size_t(b)];
+    if (n.count > 0) {
+      p.references = n.count;
+      std::fill(p.cost, p.cost + kWidth, leafCost(area, n.count));
+      std::fill(p.leftSlots, p.leftSlots + kWidth, 0);
+      p.asLeaf = true;
+      return;
+    }
+    const SlotPlan& l = plan_[size_t(n.left)];
+    const SlotPlan& r = plan_[size_t(n.right)];
+    p.references = l.references + r.references;
+    p.leftSlots[0] = 0;
+    for (int i = 2; i <= kWidth; ++i) {
+      float best = INFINITY;
+      int bestLeft = 1;
+      for (int k = 1; k < i; ++k) {
+        const float c = l.cost[k - 1] + r.cost[i - k - 1];
+        if (c < best) {
+          best = c;
+          bestLeft = k;
+        }
+      }
+      p.cost[i - 1] = best;
+      p.leftSlots[i - 1] = (unsigned char)bestLeft;
+    }
+    const float leaf = leafCost(area, p.references);
+    const float wide = area * kTraversalCost + p.cost[kWidth - 1];
+    p.asLeaf = leaf <= wide;
+    p.cost[0] = std::min(leaf, wide);
+  }
+
+  // The binary nodes that fill the slots of binary node b's plan for at most `slots`.
+  void collectSlots(int b, int slots, std::vector<int>& out) const {
+    const BinaryNode& n = binary_[size_t(b)];
+    if (slots == 1 || n.count > 0) {
+      out.push_back(b);
+      return;
+    }
+    const int left = plan_[size_t(b)].leftSlots[slots - 1];
+    collectSlots(n.left, left, out);
+    collectSlots(n.right, slots - left, out);
+  }
+
   static void clearNode(gpu::Bvh8Node& n) { std::memset(&n, 0, sizeof n); }
 
-  // The leaf's triangles leafTriangles[first, first + count), as one SoA block.
-  int addBlock(unsigned first, unsigned count) {
+  // The file-order triangles of binary node b's leaves, each once (spatial splits may have
+  // put pieces of one triangle in two of them).
+  void gatherTriangles(int b, std::vector<unsigned>& out) const {
+    const BinaryNode& n = binary_[size_t(b)];
+    if (n.count == 0) {
+      gatherTriangles(n.left, out);
+      gatherTriangles(n.right, out);
+      return;
+    }
+    for (unsigned k = n.first; k < n.first + n.count; ++k)
+      if (std::find(out.begin(), out.end(), leafTriangles_[k]) == out.end()) out.push_back(leafTriangles_[k]);
+  }
+
+  // The triangles (at most eight), as one SoA block.
+  int addBlock(const std::vector<unsigned>& triangles) {
     gpu::TriangleBlock8 block;
     std::memset(&block, 0, sizeof block);
     for (unsigned lane = 0; lane < 8; ++lane) {
-      if (lane >= count) {
+      if (lane >= triangles.size()) {
         block.id[lane] = -1;
         continue;
       }
-      const unsigned triangle = leafTriangles_[first + lane];
+      const unsigned triangle = triangles[lane];
       block.id[lane] = bvhIndex_[triangle];
       for (int k = 0; k < 3; ++k) {
         const float3 p = scene_.corner(triangle, k);
@@ -452,19 +557,21 @@ class WideCollapser {
       }
     }
     out_.blocks.push_back(block);
+    ++out_.stats.leaves;
     return int(out_.blocks.size() - 1);
   }
 
-  // Slot `slot` of wide node `wide` gets binary node `b`, whose subtree is at `depth`.
+  // Slot `slot` of wide node `wide` gets binary node `b`'s one-slot plan, at `depth`.
   void setChild(int wide, int slot, int b, int depth) {
     const BinaryNode& child = binary_[size_t(b)];
     int ref;
-    if (child.count > 0) {
-      ref = ~addBlock(child.first, child.count);
-      ++out_.stats.leaves;
+    if (plan_[size_t(b)].asLeaf) {
+      std::vector<unsigned> triangles;
+      gatherTriangles(b, triangles);
+      ref = ~addBlock(triangles);
       out_.stats.depth = std::max(out_.stats.depth, depth);
     } else {
-      ref = collapse(b, depth + 1);
+      ref = addWideNode(b, depth + 1);
     }
     gpu::Bvh8Node& n = out_.nodes[size_t(wide)];
     n.lo_x[slot] = child.box.lo[0];
@@ -476,24 +583,13 @@ class WideCollapser {
     n.child[slot] = ref;
   }
 
-  // Pulls grandchildren up (largest area first) until the node has 8 children.
-  int collapse(int b, int depth) {
-    std::vector<int> children = {binary_[size_t(b)].left, binary_[size_t(b)].right};
-    while (children.size() < FH_BVH_WIDTH) {
-      int best = -1;
-      float bestArea = -1.f;
-      for (size_t i = 0; i < children.size(); ++i) {
-        const BinaryNode& c = binary_[size_t(children[i])];
-        if (c.count == 0 && c.box.area() > bestArea) {
-          bestArea = c.box.area();
-          best = int(i);
-        }
-      }
-      if (best < 0) break;
-      const BinaryNode& expand = binary_[size_t(children[size_t(best)])];
-      children[size_t(best)] = expand.left;
-      children.push_back(expand.right);
-    }
+  // A wide node for inner binary node b, its slots filled by b's children's plans.
+  int addWideNode(int b, int depth) {
+    const BinaryNode& n = binary_[size_t(b)];
+    std::vector<int> children;
+    const int left = plan_[size_t(b)].leftSlots[kWidth - 1];
+    collectSlots(n.left, left, children);
+    collectSlots(n.right, kWidth - left, children);
     const int wide = int(out_.nodes.size());
     out_.nodes.emplace_back();
     clearNode(out_.nodes.back());
@@ -506,6 +602,7 @@ class WideCollapser {
   const Scene& scene_;
   const std::vector<int>& bvhIndex_;
   Bvh& out_;
+  std::vector<SlotPlan> plan_;
 };
 
 // BVH order: triangles by their first reference in the leaves, depth first, so a leaf's

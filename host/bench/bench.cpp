@@ -248,7 +248,7 @@ void printHeader(const std::vector<DeviceInfo>& devices, const ExternalTracer* e
 
 nlohmann::json sceneSummary(const std::string& name, const Scene& scene, const Bvh& bvh) {
   std::cout << "  " << name << ": BVH " << std::fixed << std::setprecision(3) << bvh.stats.buildSeconds << " s, SAH "
-            << std::setprecision(2) << bvh.stats.sahCost << ", references " << bvh.stats.references << ", "
+            << std::setprecision(2) << bvh.stats.sahCost << " (8-wide " << bvh.stats.wideSahCost << "), references " << bvh.stats.references << ", "
             << std::setprecision(1)
             << bvh.bytes() / double(1 << 20) << " MiB ("
             << double(bvh.bytes()) / double(scene.triangleCount()) << " B/triangle), depth " << bvh.stats.depth
@@ -257,6 +257,7 @@ nlohmann::json sceneSummary(const std::string& name, const Scene& scene, const B
           {"triangles", scene.triangleCount()},
           {"bvh_build_seconds", bvh.stats.buildSeconds},
           {"bvh_sah_cost", bvh.stats.sahCost},
+          {"bvh_wide_sah_cost", bvh.stats.wideSahCost},
           {"bvh_references", bvh.stats.references},
           {"bvh_bytes", bvh.bytes()},
           {"bvh_bytes_per_triangle", double(bvh.bytes()) / double(scene.triangleCount())},
