@@ -3,6 +3,7 @@
 // The *_packets kernels trace eight consecutive rays per work-item together, for coherent
 // batches; they find the same hits.
 #include "intersect_packet.h"
+#include "intersect_stream.h"
 
 // hits[i]: the closest hit as stored_hit packs it (intersect.h).
 __kernel void intersect_closest(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
@@ -22,6 +23,25 @@ __kernel void intersect_any(__global const Bvh8Node* nodes, __global const Trian
   if (i >= ray_count) return;
   const float4 o = ray_org[i], d = ray_dir[i];
   occluded[i] = find_occluder(nodes, blocks, o.xyz, d.xyz, o.w, d.w) >= 0;
+}
+
+// As intersect_any, FH_STREAM consecutive rays per work-item, traced together as a stream.
+__kernel void intersect_any_streams(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
+                                    __global const float4* ray_org, __global const float4* ray_dir,
+                                    __global int* occluded, uint ray_count) {
+  const uint first = get_global_id(0) * FH_STREAM;
+  if (first >= ray_count) return;
+  const int count = (int)min(ray_count - first, (uint)FH_STREAM);
+  RayPrecomp r[FH_STREAM];
+  float t_min[FH_STREAM], t_max[FH_STREAM];
+  for (int l = 0; l < count; ++l) {
+    const float4 o = ray_org[first + l], d = ray_dir[first + l];
+    r[l] = precompute_ray(o.xyz, d.xyz);
+    t_min[l] = o.w;
+    t_max[l] = d.w;
+  }
+  const ulong hit = find_occluders(nodes, blocks, r, t_min, t_max, count);
+  for (int l = 0; l < count; ++l) occluded[first + l] = (int)((hit >> l) & 1ul);
 }
 
 // Rays [8 i, 8 i + 8) of the batch as a packet, or one by one where they do not share the

@@ -28,6 +28,7 @@ typedef std::uint32_t uint;
 #define FH_BVH_WIDTH 8
 #define FH_MAX_LEAF_TRIANGLES 8  // a leaf is one TriangleBlock8
 #define FH_PACKET 8               // rays per work-item in the packet kernels (ray_cast.cl)
+#define FH_STREAM 64              // rays per work-item in the any-hit stream kernel (a 64-bit mask)
 
 // An 8-wide BVH node: child boxes stored as structure of arrays so one work-item tests
 // all eight with float8 operations. child[i] > 0: inner node index; child[i] < 0: leaf,

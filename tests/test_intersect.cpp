@@ -122,12 +122,13 @@ class RayCasting {
     const cl::Buffer hitBuffer = work.closestHits(q);
     cl::Buffer occludedBuffer =
         allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, q.count * 4ull + 4, "occluded");
-    caster.intersectAny(q.org, q.dir, occludedBuffer, q.count);
+    caster.intersectAny(q.org, q.dir, occludedBuffer, q.count, RayOrder::OneByOne);
     const std::vector<float> hits = work.readFloat4(hitBuffer, q.count);
     std::vector<int> occluded(q.count);
     FH_CL(dc.queue.enqueueReadBuffer(occludedBuffer, CL_TRUE, 0, q.count * 4ull, occluded.data()));
 
     expectPacketsMatchSingleRays(rays, hits, occluded, kind);
+    expectStreamsMatchSingleRays(rays, occluded, kind);
 
     const size_t half = rays.size() / 2;
     auto second = std::async(std::launch::async, checkRays, std::cref(scene), std::cref(bvh), std::cref(rays),
@@ -190,6 +191,39 @@ class RayCasting {
     EXPECT_EQ(differ, 0u) << kind << ": packets differ from single rays on " << differ << " of " << q.count
                           << " rays; first: ray " << order[first] << ", t " << hits[4 * order[first]] << " vs "
                           << ph[4 * first] << ", occluded " << occluded[order[first]] << " vs " << po[first];
+  }
+
+  // Any-hit streams (FH_STREAM rays to a work-item) must give every ray the single rays'
+  // answer: in the batch's order, and shuffled, so that each stream's rays part ways at the
+  // root, and a batch that ends in a part-filled stream.
+  void expectStreamsMatchSingleRays(const Rays& rays, const std::vector<int>& occluded, const std::string& kind) {
+    std::vector<size_t> order(rays.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    expectStreamsMatchSingleRays(rays, order, occluded, kind + ", streams in the batch's order");
+    std::shuffle(order.begin(), order.end(), std::mt19937(11));
+    order.resize(order.size() - std::min<size_t>(order.size() / 2, FH_STREAM / 2 + 1));
+    expectStreamsMatchSingleRays(rays, order, occluded, kind + ", streams shuffled");
+  }
+
+  void expectStreamsMatchSingleRays(const Rays& rays, const std::vector<size_t>& order,
+                                    const std::vector<int>& occluded, const std::string& kind) {
+    Rays sorted;
+    for (size_t i : order) {
+      sorted.org.insert(sorted.org.end(), &rays.org[4 * i], &rays.org[4 * i + 4]);
+      sorted.dir.insert(sorted.dir.end(), &rays.dir[4 * i], &rays.dir[4 * i + 4]);
+    }
+    RayQueue q = work.upload(sorted.org, sorted.dir);
+    cl::Buffer streamOccluded =
+        allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, q.count * 4ull + 4, "occluded");
+    caster.intersectAny(q.org, q.dir, streamOccluded, q.count, RayOrder::Incoherent);
+    std::vector<int> so(q.count);
+    FH_CL(dc.queue.enqueueReadBuffer(streamOccluded, CL_TRUE, 0, q.count * 4ull, so.data()));
+    size_t differ = 0, first = 0;
+    for (size_t k = 0; k < q.count; ++k)
+      if (so[k] != occluded[order[k]]) first = differ++ ? first : k;
+    EXPECT_EQ(differ, 0u) << kind << ": streams differ from single rays on " << differ << " of " << q.count
+                          << " rays; first: ray " << order[first] << ", occluded " << occluded[order[first]]
+                          << " vs " << so[first];
   }
 
   Rays download(const RayQueue& q) {

@@ -24,13 +24,12 @@ RayCaster::RayCaster(DeviceContext& dc, const Bvh& bvh) : dc_(dc), bvh_(dc, bvh)
   any_ = createKernel(program, "intersect_any");
   closestPackets_ = createKernel(program, "intersect_closest_packets");
   anyPackets_ = createKernel(program, "intersect_any_packets");
+  anyStreams_ = createKernel(program, "intersect_any_streams");
 }
 
 namespace {
-// Work-items for `count` rays: one per ray, or one per packet of FH_PACKET rays.
-size_t workItems(unsigned count, RayOrder order) {
-  return order == RayOrder::Coherent ? (count + FH_PACKET - 1) / FH_PACKET : count;
-}
+// Work-items for `count` rays, `perItem` to a work-item.
+size_t workItems(unsigned count, unsigned perItem) { return (count + perItem - 1) / perItem; }
 }  // namespace
 
 void RayCaster::intersectClosest(const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& hits,
@@ -38,15 +37,24 @@ void RayCaster::intersectClosest(const cl::Buffer& org, const cl::Buffer& dir, c
   const bool packets = order == RayOrder::Coherent;
   cl::Kernel& kernel = packets ? closestPackets_ : closest_;
   setKernelArgs(kernel, nodes(), blocks(), org, dir, hits, count);
-  launch(dc_, kernel, workItems(count, order), packets ? "intersect_closest_packets" : "intersect_closest", event);
+  launch(dc_, kernel, workItems(count, packets ? FH_PACKET : 1),
+         packets ? "intersect_closest_packets" : "intersect_closest", event);
 }
 
 void RayCaster::intersectAny(const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& occluded,
                              unsigned count, RayOrder order, cl::Event* event) {
-  const bool packets = order == RayOrder::Coherent;
-  cl::Kernel& kernel = packets ? anyPackets_ : any_;
-  setKernelArgs(kernel, nodes(), blocks(), org, dir, occluded, count);
-  launch(dc_, kernel, workItems(count, order), packets ? "intersect_any_packets" : "intersect_any", event);
+  struct Choice {
+    cl::Kernel* kernel;
+    unsigned raysPerItem;
+    const char* name;
+  };
+  Choice c{&any_, 1, "intersect_any"};
+  if (order == RayOrder::Coherent)
+    c = {&anyPackets_, FH_PACKET, "intersect_any_packets"};
+  else if (order == RayOrder::Incoherent && dc_.info.type == "cpu")
+    c = {&anyStreams_, FH_STREAM, "intersect_any_streams"};
+  setKernelArgs(*c.kernel, nodes(), blocks(), org, dir, occluded, count);
+  launch(dc_, *c.kernel, workItems(count, c.raysPerItem), c.name, event);
 }
 
 }  // namespace fh

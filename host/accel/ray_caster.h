@@ -28,10 +28,14 @@ class DeviceBvh {
   cl::Buffer nodes_, blocks_, triangles_;
 };
 
-// How a batch of rays is laid out: coherent batches (camera rays in pixel order, where
-// neighbours in the batch take nearly the same path through the tree) are traced eight
-// at a time as packets. Either way the hits are the same, bit for bit.
-enum class RayOrder { Incoherent, Coherent };
+// How a batch of rays is laid out, which picks the kernels that trace it. Coherent batches
+// (camera rays in pixel order, where neighbours in the batch take nearly the same path
+// through the tree) are traced eight at a time as packets. Otherwise closest hits are traced
+// one ray per work-item, and on a CPU any-hit queries as streams of FH_STREAM consecutive
+// rays (kernels/intersect_stream.h: a stream's private state is too large for a GPU's
+// work-items). OneByOne traces every ray on its own, as the path tracer's stages do.
+// Whichever kernels, the answers are the same, bit for bit.
+enum class RayOrder { Incoherent, Coherent, OneByOne };
 
 // Ray casting as an operation of its own: the BVH and the intersect kernels over arrays
 // of rays (the bench, --aov, tests). The path tracer traverses the BVH inside its stages.
@@ -56,7 +60,7 @@ class RayCaster {
   DeviceContext& dc_;
   DeviceBvh bvh_;
   ProgramBuildInfo buildInfo_;
-  cl::Kernel closest_, any_, closestPackets_, anyPackets_;
+  cl::Kernel closest_, any_, closestPackets_, anyPackets_, anyStreams_;
 };
 
 }  // namespace fh
