@@ -18,7 +18,7 @@ FH_INLINE int lowest_bit64(ulong m) { return 63 - (int)clz(m & (0ul - m)); }
 // Bit l set where ray l (l < count) has an occluder on [t_min[l], t_max[l]).
 FH_INLINE ulong find_occluders(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
                                const RayPrecomp* r, const float* t_min, const float* t_max, int count) {
-  ulong open = count == FH_STREAM ? ~0ul : (1ul << count) - 1ul;  // rays not yet occluded
+  ulong open = count >= 64 ? ~0ul : (1ul << count) - 1ul;  // rays not yet occluded
   ulong occluded = 0ul;
   int stack_ref[FH_TRAVERSAL_STACK];
   ulong stack_rays[FH_TRAVERSAL_STACK];
@@ -49,7 +49,7 @@ FH_INLINE ulong find_occluders(__global const Bvh8Node* nodes, __global const Tr
         const int highest = 31 - (int)clz(c);
         const int child = node->child[highest];
         fetch_child_early(nodes, blocks, child);
-        stack_ref[sp] = node->child[highest];
+        stack_ref[sp] = child;
         stack_rays[sp++] = pushed[highest];
       }
     } else {
