@@ -202,13 +202,20 @@ FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8
 // ray touches (Ize, "Robust BVH Ray Traversal", JCGT 2013).
 #define FH_SLAB_WIDEN 1.0000003576f
 
-// The slab test's near distance from the six slab distances, +INFINITY where the slabs'
-// intersection, clipped to [0, t_max], is empty. Single rays (eight children) and packets
-// (eight rays) share it, so both cull the same boxes.
-FH_INLINE float8 slab_near(float8 tx0, float8 tx1, float8 ty0, float8 ty1, float8 tz0, float8 tz1, float8 t_max) {
-  const float8 t_near = max8(max8(min8(tx0, tx1), min8(ty0, ty1)), max8(min8(tz0, tz1), (float8)(0.0f)));
-  const float8 t_far = min8(min8(max8(tx0, tx1), max8(ty0, ty1)), min8(max8(tz0, tz1), t_max)) * FH_SLAB_WIDEN;
+// The slab test's near distance from each axis' entry and exit distances, +INFINITY where
+// the slabs' intersection, clipped to [0, t_max], is empty. Single rays (eight children)
+// and packets (eight rays) both end their box tests here, so both cull the same boxes.
+FH_INLINE float8 slab_entry(float8 nx, float8 ny, float8 nz, float8 fx, float8 fy, float8 fz, float8 t_max) {
+  const float8 t_near = max8(max8(nx, ny), max8(nz, (float8)(0.0f)));
+  const float8 t_far = min8(min8(fx, fy), min8(fz, t_max)) * FH_SLAB_WIDEN;
   return select(t_near, (float8)(INFINITY), t_near > t_far);
+}
+
+// slab_entry from the six slab distances, each axis' two sorted by comparing them (packets,
+// whose rays may enter a box by different planes).
+FH_INLINE float8 slab_near(float8 tx0, float8 tx1, float8 ty0, float8 ty1, float8 tz0, float8 tz1, float8 t_max) {
+  return slab_entry(min8(tx0, tx1), min8(ty0, ty1), min8(tz0, tz1), max8(tx0, tx1), max8(ty0, ty1), max8(tz0, tz1),
+                    t_max);
 }
 
 // Near distances of the eight children; lanes the ray misses get +INFINITY. Each axis'
@@ -223,22 +230,8 @@ FH_INLINE float8 intersect_children(const RayPrecomp* r, __global const Bvh8Node
   const float8 fy = (vload8(0, planes + (r->near_y ^ 8)) - (float8)(r->org_far.y)) * iy;
   const float8 nz = (vload8(0, planes + r->near_z) - (float8)(r->org_near.z)) * iz;
   const float8 fz = (vload8(0, planes + (r->near_z ^ 8)) - (float8)(r->org_far.z)) * iz;
-  const float8 t_near = max8(max8(nx, ny), max8(nz, (float8)(0.0f)));
-  const float8 t_far = min8(min8(fx, fy), min8(fz, (float8)(t_max))) * FH_SLAB_WIDEN;
-  const int8 missed = (t_near > t_far) | (vload8(0, node->child) == (int8)(0));
-  return select(t_near, (float8)(INFINITY), missed);
-}
-
-// Asks for a child's lines (a node's boxes or a leaf's triangles) ahead of its visit, for
-// children that wait on the stack a while before they are popped: every other 64-byte
-// line, as x86 caches fetch lines in pairs. x86 only (the hint is a Clang built-in);
-// elsewhere nothing.
-FH_INLINE void fetch_child_early(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, int child) {
-#ifdef __AVX__
-  __global const char* p = child >= 0 ? (__global const char*)(nodes + child) : (__global const char*)(blocks + ~child);
-  const int bytes = child >= 0 ? (int)sizeof(Bvh8Node) : (int)sizeof(TriangleBlock8);
-  for (int offset = 0; offset < bytes; offset += 128) __builtin_prefetch(p + offset);
-#endif
+  const int8 empty = vload8(0, node->child) == (int8)(0);
+  return select(slab_entry(nx, ny, nz, fx, fy, fz, (float8)(t_max)), (float8)(INFINITY), empty);
 }
 
 typedef struct {

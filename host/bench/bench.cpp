@@ -248,7 +248,8 @@ void printHeader(const std::vector<DeviceInfo>& devices, const ExternalTracer* e
 
 nlohmann::json sceneSummary(const std::string& name, const Scene& scene, const Bvh& bvh) {
   std::cout << "  " << name << ": BVH " << std::fixed << std::setprecision(3) << bvh.stats.buildSeconds << " s, SAH "
-            << std::setprecision(2) << bvh.stats.sahCost << " (8-wide " << bvh.stats.wideSahCost << "), references " << bvh.stats.references << ", "
+            << std::setprecision(2) << bvh.stats.sahCost << " (8-wide " << bvh.stats.wideSahCost << "), references "
+            << bvh.stats.references << ", "
             << std::setprecision(1)
             << bvh.bytes() / double(1 << 20) << " MiB ("
             << double(bvh.bytes()) / double(scene.triangleCount()) << " B/triangle), depth " << bvh.stats.depth
