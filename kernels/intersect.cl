@@ -1,12 +1,27 @@
 // The path tracer's intersect stage: the closest hit of each path's ray (ray casting over
 // plain arrays of rays, for the bench and the tests, is ray_cast.cl).
-#include "intersect.h"
+#include "lane_rays.h"
 
 // Closest hit for the ray of path slot p: reads ray_org/ray_dir, writes hit.
 FH_INLINE void intersect_slot(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, uint p,
                               __global const float4* ray_org, __global const float4* ray_dir, __global float4* hit) {
   const float4 o = ray_org[p], d = ray_dir[p];
   hit[p] = stored_hit(trace_ray(nodes, blocks, o.xyz, d.xyz, o.w, d.w));
+}
+
+// Closest hits for the rays of the lanes' path slots p where `active` (the megakernel's
+// eight paths): intersect_slot for each, their rays set up together.
+FH_INLINE void intersect_lanes(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, luint p,
+                               lmask active, __global const float4* ray_org, __global const float4* ray_dir,
+                               __global float4* hit) {
+  const lfloat t_min = gather_w(ray_org, p), t_max = gather_w(ray_dir, p);
+  LaneRays rays;
+  precompute_lane_rays(gather_xyz(ray_org, p), gather_xyz(ray_dir, p), &rays);
+  FH_EACH_LANE(l) {
+    if (LANE(active, l))
+      hit[LANE(p, l)] =
+          stored_hit(trace_precomputed(nodes, blocks, lane_ray(&rays, l), LANE(t_min, l), LANE(t_max, l)));
+  }
 }
 
 #if !defined(FH_MEGAKERNEL)  // the megakernel calls the stage function itself

@@ -99,6 +99,89 @@ FH_INLINE RayPrecomp precompute_ray(float3 org, float3 dir) {
   return r;
 }
 
+// precompute_ray for eight rays, ray l in lane l: the same operations on the same values
+// (the same bits), with one vector division where eight rays took a scalar one each. Kept
+// as arrays, so a traversal reads its ray's constants (ray_of_lane) with plain loads.
+typedef struct {
+  float inv_x[8], inv_y[8], inv_z[8];
+  int near_x[8], near_y[8], near_z[8];
+  float org_near_x[8], org_near_y[8], org_near_z[8], org_far_x[8], org_far_y[8], org_far_z[8];
+  int kx[8], ky[8], kz[8];
+  float sx[8], sy[8], sz[8];
+  float ox[8], oy[8], oz[8];
+} RayPrecomp8;
+
+// Component k (0: x, 1: y, 2: z) of (x, y, z), per lane.
+FH_INLINE float8 component8(float8 x, float8 y, float8 z, int8 k) {
+  return select(select(z, y, k == (int8)(1)), x, k == (int8)(0));
+}
+
+FH_INLINE void precompute_rays8(float8 ox, float8 oy, float8 oz, float8 dx, float8 dy, float8 dz, RayPrecomp8* r) {
+  const float8 ax = fabs(dx), ay = fabs(dy), az = fabs(dz);
+  const int8 two = (int8)(2), zero = (int8)(0);
+  const int8 kz = select(select(two, (int8)(1), ay > az), select(two, zero, ax > az), ax > ay);
+  int8 kx = select(kz + 1, zero, kz == two);
+  int8 ky = select(kx + 1, zero, kx == two);
+  const float8 along = component8(dx, dy, dz, kz);
+  const int8 down = along < (float8)(0.0f);  // keep the winding: swap kx and ky
+  const int8 swapped = kx;
+  kx = select(kx, ky, down);
+  ky = select(ky, swapped, down);
+  vstore8(kx, 0, r->kx);
+  vstore8(ky, 0, r->ky);
+  vstore8(kz, 0, r->kz);
+  vstore8(component8(dx, dy, dz, kx) / along, 0, r->sx);
+  vstore8(component8(dx, dy, dz, ky) / along, 0, r->sy);
+  vstore8(1.0f / along, 0, r->sz);
+  vstore8(component8(ox, oy, oz, kx), 0, r->ox);
+  vstore8(component8(ox, oy, oz, ky), 0, r->oy);
+  vstore8(component8(ox, oy, oz, kz), 0, r->oz);
+  // Zero direction components as precompute_ray treats them, one axis at a time.
+  const float8 tiny = (float8)(1e-30f), one = (float8)(1.0f);
+  const int8 flat_x = ax < tiny, flat_y = ay < tiny, flat_z = az < tiny;
+  const float8 eps_x = fmax(fabs(ox), one) * 0x1p-20f, eps_y = fmax(fabs(oy), one) * 0x1p-20f,
+               eps_z = fmax(fabs(oz), one) * 0x1p-20f;
+  const float8 inv_x = 1.0f / select(dx, tiny, flat_x), inv_y = 1.0f / select(dy, tiny, flat_y),
+               inv_z = 1.0f / select(dz, tiny, flat_z);
+  vstore8(inv_x, 0, r->inv_x);
+  vstore8(inv_y, 0, r->inv_y);
+  vstore8(inv_z, 0, r->inv_z);
+  const float8 lo_x = select(ox, ox + eps_x, flat_x), hi_x = select(ox, ox - eps_x, flat_x);
+  const float8 lo_y = select(oy, oy + eps_y, flat_y), hi_y = select(oy, oy - eps_y, flat_y);
+  const float8 lo_z = select(oz, oz + eps_z, flat_z), hi_z = select(oz, oz - eps_z, flat_z);
+  const int8 fwd_x = inv_x >= (float8)(0.0f), fwd_y = inv_y >= (float8)(0.0f), fwd_z = inv_z >= (float8)(0.0f);
+  vstore8(select((int8)(8), zero, fwd_x), 0, r->near_x);
+  vstore8(select((int8)(24), (int8)(16), fwd_y), 0, r->near_y);
+  vstore8(select((int8)(40), (int8)(32), fwd_z), 0, r->near_z);
+  vstore8(select(hi_x, lo_x, fwd_x), 0, r->org_near_x);
+  vstore8(select(hi_y, lo_y, fwd_y), 0, r->org_near_y);
+  vstore8(select(hi_z, lo_z, fwd_z), 0, r->org_near_z);
+  vstore8(select(lo_x, hi_x, fwd_x), 0, r->org_far_x);
+  vstore8(select(lo_y, hi_y, fwd_y), 0, r->org_far_y);
+  vstore8(select(lo_z, hi_z, fwd_z), 0, r->org_far_z);
+}
+
+// Ray l's constants from precompute_rays8.
+FH_INLINE RayPrecomp ray_of_lane(const RayPrecomp8* s, int l) {
+  RayPrecomp r;
+  r.inv_dir = (float3)(s->inv_x[l], s->inv_y[l], s->inv_z[l]);
+  r.near_x = s->near_x[l];
+  r.near_y = s->near_y[l];
+  r.near_z = s->near_z[l];
+  r.org_near = (float3)(s->org_near_x[l], s->org_near_y[l], s->org_near_z[l]);
+  r.org_far = (float3)(s->org_far_x[l], s->org_far_y[l], s->org_far_z[l]);
+  r.kx = s->kx[l];
+  r.ky = s->ky[l];
+  r.kz = s->kz[l];
+  r.sx = s->sx[l];
+  r.sy = s->sy[l];
+  r.sz = s->sz[l];
+  r.ox = s->ox[l];
+  r.oy = s->oy[l];
+  r.oz = s->oz[l];
+  return r;
+}
+
 // 1 + 2^-20: widens the division-free interval test below so that it never rejects a lane
 // whose quotient (the t a hit keeps) equals the current hit's t: the products round on
 // their own, by a few ulps at most.
@@ -287,10 +370,9 @@ FH_INLINE int order_children(float8 t_near, __global const Bvh8Node* node, int* 
   return node->child[order[n - 1]];
 }
 
-// The closest hit in [t_min, t_max).
-FH_INLINE TraceHit trace_ray(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, float3 org,
-                             float3 dir, float t_min, float t_max) {
-  const RayPrecomp r = precompute_ray(org, dir);
+// The closest hit in [t_min, t_max) of the ray r was precomputed from.
+FH_INLINE TraceHit trace_precomputed(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
+                                     RayPrecomp r, float t_min, float t_max) {
   TraceHit hit;
   hit.t = t_max;
   hit.b1 = hit.b2 = 0.0f;
@@ -323,6 +405,12 @@ FH_INLINE TraceHit trace_ray(__global const Bvh8Node* nodes, __global const Tria
   }
 }
 
+// The closest hit in [t_min, t_max).
+FH_INLINE TraceHit trace_ray(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, float3 org,
+                             float3 dir, float t_min, float t_max) {
+  return trace_precomputed(nodes, blocks, precompute_ray(org, dir), t_min, t_max);
+}
+
 // A triangle on the segment [t_min, t_max), as its BVH-order index, or -1 if there is none
 // (shadow rays). Any occluder ends the query, near or far, and the segment never shortens,
 // so no child needs its distance: the children are visited in lane order, and a node's
@@ -330,9 +418,8 @@ FH_INLINE TraceHit trace_ray(__global const Bvh8Node* nodes, __global const Tria
 // (one entry per level, none per child).
 // Every child the segment touches is still visited until an occluder is found, so whether
 // there is one does not depend on the order (which one is found does).
-FH_INLINE int find_occluder(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, float3 org,
-                            float3 dir, float t_min, float t_max) {
-  const RayPrecomp r = precompute_ray(org, dir);
+FH_INLINE int find_occluder_precomputed(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
+                                        RayPrecomp r, float t_min, float t_max) {
   int stack_node[FH_TRAVERSAL_STACK];
   uint stack_pending[FH_TRAVERSAL_STACK];
   int sp = 0;
@@ -366,6 +453,11 @@ FH_INLINE int find_occluder(__global const Bvh8Node* nodes, __global const Trian
     else
       --sp;
   }
+}
+
+FH_INLINE int find_occluder(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, float3 org,
+                            float3 dir, float t_min, float t_max) {
+  return find_occluder_precomputed(nodes, blocks, precompute_ray(org, dir), t_min, t_max);
 }
 
 #endif

@@ -52,9 +52,7 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
         alive = alive || starts;
       }
       if (!lanes_any(alive)) break;
-      FH_EACH_LANE(l) {
-        if (LANE(alive, l)) intersect_slot(nodes, blocks, LANE(p, l), ray_org, ray_dir, hit);
-      }
+      intersect_lanes(nodes, blocks, p, alive, ray_org, ray_dir, hit);
       const ShadeOutcome o = shade_paths(params, p, alive, triangles, triangle_material, materials, light_pdf_area,
                                          normals, uvs, texels, texture_info, env_map, aovs FH_PATH_ARGS);
       if (lanes_any(o.light_sample))  // never for pt, nor without lights

@@ -6,7 +6,7 @@
 // Each work-item connects FH_LANES consecutive requests (lanes.h); their shadow rays are
 // traced one after the other.
 #include "bsdf.h"
-#include "intersect.h"
+#include "lane_rays.h"
 #include "lights.h"
 #include "path_state.h"
 #include "ray.h"
@@ -138,10 +138,11 @@ FH_INLINE void connect_light(RenderParams params, const ShadowRequest* r, lmask 
       v3_scale(v3_mul(v3_mul(r->throughput, f), ls.radiance), cos_surface * weight / ls.pdf);
   connects = connects && v3_any_positive(contribution);
 
+  LaneRays rays;
+  precompute_lane_rays(origin, ls.shadow_direction, &rays);
   FH_EACH_LANE(k) {
     if (!LANE(connects, k)) continue;
-    if (find_occluder(nodes, blocks, v3_lane(origin, k), v3_lane(ls.shadow_direction, k), 0.0f,
-                      LANE(ls.shadow_distance, k)) >= 0)
+    if (find_occluder_precomputed(nodes, blocks, lane_ray(&rays, k), 0.0f, LANE(ls.shadow_distance, k)) >= 0)
       continue;
     radiance[LANE(p, k)] += (float4)(v3_lane(contribution, k), 0.0f);
   }

@@ -21,6 +21,8 @@
 #include "accel/bvh.h"
 #include "base/vec.h"
 #include "bench/ray_workload.h"
+#include "device/kernel_sources.h"
+#include "device/program.h"
 #include "scene/icosphere.h"
 #include "scene/scene_loader.h"
 #include "scene_builder.h"
@@ -520,6 +522,71 @@ TEST(BvhBuild, SpatialSplitsCutLongTrianglesWithoutGaps) {
   ASSERT_GT(rays.size(), 100u);
   RayCasting rc(scene);
   rc.expectMatchesReference(rays, "aimed at triangles cut by spatial splits");
+}
+
+// Rays set up eight at once (precompute_rays8: the megakernel's lanes, the shadow stage's)
+// must get every constant precompute_ray gives each alone, bit for bit, or the strategies'
+// images part: directions with zero and negative-zero components, components of equal
+// size (the dominant-axis choice's ties), denormals, and origins on either side of 1.
+TEST(RayConstants, EightRaysAtOnceGetEachRaysOwnBits) {
+  const char* kernel = R"CL(
+FH_INLINE void put(__global uint* out, RayPrecomp r) {
+  const uint v[21] = {as_uint(r.inv_dir.x), as_uint(r.inv_dir.y), as_uint(r.inv_dir.z), r.near_x, r.near_y,
+                      r.near_z, as_uint(r.org_near.x), as_uint(r.org_near.y), as_uint(r.org_near.z),
+                      as_uint(r.org_far.x), as_uint(r.org_far.y), as_uint(r.org_far.z), r.kx, r.ky, r.kz,
+                      as_uint(r.sx), as_uint(r.sy), as_uint(r.sz), as_uint(r.ox), as_uint(r.oy), as_uint(r.oz)};
+  for (int k = 0; k < 21; ++k) out[k] = v[k];
+}
+__kernel void constants(__global const float4* org, __global const float4* dir, __global uint* alone,
+                        __global uint* together) {
+  const uint first = get_global_id(0) * 8;
+  float o[3][8], d[3][8];
+  for (int l = 0; l < 8; ++l) {
+    put(alone + 21 * (first + l), precompute_ray(org[first + l].xyz, dir[first + l].xyz));
+    for (int a = 0; a < 3; ++a) {
+      o[a][l] = org[first + l][a];
+      d[a][l] = dir[first + l][a];
+    }
+  }
+  RayPrecomp8 eight;
+  precompute_rays8(vload8(0, o[0]), vload8(0, o[1]), vload8(0, o[2]), vload8(0, d[0]), vload8(0, d[1]),
+                   vload8(0, d[2]), &eight);
+  for (int l = 0; l < 8; ++l) put(together + 21 * (first + l), ray_of_lane(&eight, l));
+}
+)CL";
+  DeviceContext& dc = test::defaultDevice();
+  const cl::Program program =
+      buildProgramFromSource(dc.context, dc.info.device, assembleKernelSources({"intersect.h"}) + kernel, "");
+  const float special[] = {0.f, -0.f, 1.f, -1.f, 0.5f, -0.5f, 1e-31f, -1e-31f, 1e-40f, 3.f};
+  Rays rays;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-4.f, 4.f);
+  std::uniform_int_distribution<size_t> pick(0, std::size(special) - 1);
+  for (int i = 0; i < 4096; ++i) {
+    float3 d{}, o{};
+    for (size_t a = 0; a < 3; ++a) {
+      d[a] = i % 2 ? special[pick(rng)] : u(rng);
+      o[a] = i % 3 ? u(rng) * 100.f : special[pick(rng)];
+    }
+    if (d[0] == 0.f && d[1] == 0.f && d[2] == 0.f) d[1] = -2.f;  // a ray needs a direction
+    rays.add(o, d);
+  }
+  const size_t n = rays.size(), words = 21 * n * sizeof(cl_uint);
+  cl::Buffer org = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, n * 16, "origins", rays.org.data());
+  cl::Buffer dir = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, n * 16, "directions", rays.dir.data());
+  cl::Buffer alone = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, words, "one at a time");
+  cl::Buffer together = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, words, "eight at once");
+  cl::Kernel k = createKernel(program, "constants");
+  setKernelArgs(k, org, dir, alone, together);
+  FH_CL(dc.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n / 8)));
+  std::vector<cl_uint> a(21 * n), t(21 * n);
+  FH_CL(dc.queue.enqueueReadBuffer(alone, CL_TRUE, 0, words, a.data()));
+  FH_CL(dc.queue.enqueueReadBuffer(together, CL_TRUE, 0, words, t.data()));
+  size_t differ = 0, first = 0;
+  for (size_t w = 0; w < a.size(); ++w)
+    if (a[w] != t[w]) first = differ++ ? first : w;
+  EXPECT_EQ(differ, 0u) << "first: ray " << first / 21 << ", constant " << first % 21 << ": " << a[first] << " vs "
+                        << t[first];
 }
 
 TEST(Watertight, RaysAtSharedEdgesAndVerticesNeverMiss) {
