@@ -27,6 +27,8 @@ constexpr float kTriangleCost = 0.15f;
 // Testing a leaf block costs the same however many of its eight lanes are filled
 // (WideCollapser chooses the 8-wide tree with it).
 constexpr float kLeafBlockCost = kTriangleCost * float(kMaxLeaf);
+// The binary builder counts a child's triangles in groups of this many (see groupedCount).
+constexpr size_t kCountGroup = kMaxLeaf / 2;
 // Spatial splits are tried where the best object split's children overlap by more than
 // this fraction of the root's area (Stich et al.'s alpha, who use 1e-5): below it they gain
 // little, and trying them costs a clipping pass over the node's references.
@@ -182,15 +184,17 @@ class BinaryBuilder {
     size_t leftCount = 0, rightCount = 0;
   };
 
-  // Triangles cost by the block: a leaf of n is tested as ceil(n / 8) TriangleBlock8s, each
-  // costing all eight lanes (as Embree's builders count by their leaves' blocks). Counting
-  // single triangles instead favours even halves (twelve as six and six: two blocks a
-  // quarter empty) where eight and four cost the same to test once collapsed.
-  static float blockedCount(size_t n) { return float((n + kMaxLeaf - 1) / kMaxLeaf * kMaxLeaf); }
+  // Triangles cost by groups of four (half a TriangleBlock8), as Embree's builders count by
+  // their leaves' blocks: counting single triangles favours even halves (twelve as six and
+  // six, two blocks a quarter empty) where eight and four cost the same to test once
+  // collapsed. Whole blocks of eight would be the leaf test's true cost, but they make the
+  // builder stop at bigger, looser leaves that the wide collapse can no longer split
+  // (bench/RESULTS.md: the Cornell box's tree got worse).
+  static float groupedCount(size_t n) { return float((n + kCountGroup - 1) / kCountGroup * kCountGroup); }
 
   float cost(const Box& left, size_t nLeft, const Box& right, size_t nRight, float parentArea) const {
     return kTraversalCost +
-           kTriangleCost * (left.area() * blockedCount(nLeft) + right.area() * blockedCount(nRight)) / parentArea;
+           kTriangleCost * (left.area() * groupedCount(nLeft) + right.area() * groupedCount(nRight)) / parentArea;
   }
 
   // Binned over the references' centroids, all three axes in one pass over them.
@@ -335,7 +339,7 @@ class BinaryBuilder {
       const size_t added = spatial.leftCount + spatial.rightCount - count;
       if (spatial.cost < s.cost * (1.f - kSpatialSplitGain) && added <= room) s = spatial;
     }
-    if (s.axis >= 0 && count <= kMaxLeaf && kLeafBlockCost <= s.cost) return makeLeaf(node, refs);
+    if (s.axis >= 0 && count <= kMaxLeaf && kTriangleCost * float(count) <= s.cost) return makeLeaf(node, refs);
 
     // A spatial split's children own their references (this frame keeps them alive);
     // an object split's partition the node's in place.
