@@ -455,6 +455,7 @@ FH_INLINE int find_occluder_precomputed(__global const Bvh8Node* nodes, __global
   }
 }
 
+// find_occluder_precomputed for the ray from org along dir.
 FH_INLINE int find_occluder(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, float3 org,
                             float3 dir, float t_min, float t_max) {
   return find_occluder_precomputed(nodes, blocks, precompute_ray(org, dir), t_min, t_max);
