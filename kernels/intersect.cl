@@ -14,9 +14,10 @@ FH_INLINE void intersect_slot(__global const Bvh8Node* nodes, __global const Tri
 FH_INLINE void intersect_lanes(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, luint p,
                                lmask active, __global const float4* ray_org, __global const float4* ray_dir,
                                __global float4* hit) {
-  const lfloat t_min = gather_w(ray_org, p), t_max = gather_w(ray_dir, p);
+  lfloat t_min, t_max;
+  const lvec3 org = gather_xyzw(ray_org, p, &t_min), dir = gather_xyzw(ray_dir, p, &t_max);
   LaneRays rays;
-  precompute_lane_rays(gather_xyz(ray_org, p), gather_xyz(ray_dir, p), &rays);
+  precompute_lane_rays(org, dir, &rays);
   FH_EACH_LANE(l) {
     if (LANE(active, l))
       hit[LANE(p, l)] =

@@ -157,6 +157,18 @@ FH_INLINE lvec2 gather_xy(__global const float2* base, luint index) {
   }
   return r;
 }
+// The xyz of float4 elements, and their w into *w: each element read once.
+FH_INLINE lvec3 gather_xyzw(__global const float4* base, luint index, lfloat* w) {
+  lvec3 r;
+  FH_FOR_LANES(l) {
+    const float4 e = base[LANE(index, l)];
+    LANE(r.x, l) = e.x;
+    LANE(r.y, l) = e.y;
+    LANE(r.z, l) = e.z;
+    LANE(*w, l) = e.w;
+  }
+  return r;
+}
 // The w of float4 elements.
 FH_INLINE lfloat gather_w(__global const float4* base, luint index) {
   lfloat r;

@@ -84,8 +84,7 @@ FH_INLINE void store_shadow_request(const ShadowRequest* r, luint index, lmask m
 FH_INLINE ShadowRequest load_shadow_request(luint index FH_SHADOW_PARAMS) {
   ShadowRequest r;
   r.path = gather_uint(shadow_path, index);
-  r.at.position = gather_xyz(shadow_position, index);
-  r.at.magnitude = gather_w(shadow_position, index);
+  r.at.position = gather_xyzw(shadow_position, index, &r.at.magnitude);
   r.at.normal = gather_xyz(shadow_geometric, index);
   r.shading_normal = gather_xyz(shadow_normal, index);
   r.albedo = gather_xyz(shadow_albedo, index);

@@ -90,8 +90,9 @@ FH_INLINE ShadeOutcome shade_paths(RenderParams params, luint p, lmask active, _
     const lvec3 beta_in = gather_xyz(throughput, p);
     const luint bounce = gather_uint(depth, p);
     lvec3 gathered = gather_xyz(radiance, p);
-    const lvec3 h = gather_xyz(hit, p);  // t, b1, b2
-    const lint hit_triangle = las_int(gather_w(hit, p));
+    lfloat triangle_bits;
+    const lvec3 h = gather_xyzw(hit, p, &triangle_bits);  // t, b1, b2
+    const lint hit_triangle = las_int(triangle_bits);
     const lmask escaped = active && hit_triangle < 0, hits = active && hit_triangle >= 0;
     gathered = v3_select(escaped, v3_add(gathered, v3_mul(beta_in, v3_uniform(vload3(0, params.env)))), gathered);
 #if defined(FH_ENV_MAP)
