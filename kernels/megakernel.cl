@@ -1,7 +1,7 @@
 // The megakernel strategies: each work-item runs every stage for its FH_LANES path slots
 // in one kernel, in a loop (no queues; a light-sample request goes straight to
-// connect_light), and where a lane's path ends, starts the lane's next sample in the same
-// slot (path regeneration), so lanes stay busy although paths differ in length. It calls
+// connect_light), and once all of its lanes' paths have ended, starts their next samples in
+// the same slots (path regeneration, a work-item's lanes at a time). It calls
 // the stages' own functions, so it computes the same estimator and the same image bits for
 // a seed. Every path it starts ends in the same launch: plan_iteration (built with
 // FH_MEGAKERNEL) carries no rays over, and the free list is left as it was.
@@ -44,14 +44,17 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
     lmask alive = lanes_mask(false);
     uint bounce_rays = 0, shadow_rays = 0, nonfinite = 0;
     for (;;) {
-      const lmask starts = owns_slot && !alive && next < count;
-      if (lanes_any(starts)) {
-        start_sample(params, older, newer, entries, counters->new_first + next, p, starts, filter_table, pass_table,
+      // The lanes start their next samples together, once all of the work-item's paths have
+      // ended, not each as soon as its own ends: the lanes then follow neighbouring pixels at
+      // the same depth, whose rays and materials take the same branches, and that pays more
+      // than the lanes left idle cost (bench/RESULTS.md).
+      if (!lanes_any(alive)) {
+        alive = owns_slot && next < count;
+        if (!lanes_any(alive)) break;
+        start_sample(params, older, newer, entries, counters->new_first + next, p, alive, filter_table, pass_table,
                      pixel_list FH_PATH_ARGS);
-        next = select(next, next + slots, starts);
-        alive = alive || starts;
+        next = select(next, next + slots, alive);
       }
-      if (!lanes_any(alive)) break;
       intersect_lanes(nodes, blocks, p, alive, ray_org, ray_dir, hit);
       const ShadeOutcome o = shade_paths(params, p, alive, triangles, triangle_material, materials, light_pdf_area,
                                          normals, uvs, texels, texture_info, env_map, aovs FH_PATH_ARGS);
