@@ -25,6 +25,28 @@ FH_INLINE void intersect_lanes(__global const Bvh8Node* nodes, __global const Tr
   }
 }
 
+// intersect_lanes for the camera rays of samples that start together (the megakernel's
+// lanes, neighbouring pixels): they take nearly the same path through the tree, and one
+// traversal serves all eight (intersect_packet.h: the same hits, bit for bit).
+FH_INLINE void intersect_camera_lanes(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, luint p,
+                                      lmask active, __global const float4* ray_org, __global const float4* ray_dir,
+                                      __global float4* hit) {
+#if FH_LANES == 8
+  lfloat t_min, t_max;
+  const lvec3 org = gather_xyzw(ray_org, p, &t_min), dir = gather_xyzw(ray_dir, p, &t_max);
+  RayPacket packet;
+  make_lane_packet(org, dir, t_min, active, &packet);
+  const PacketHits h = trace_packet_lanes(nodes, blocks, &packet, select((lfloat)(-INFINITY), t_max, active), false);
+  FH_EACH_LANE(l) {
+    if (!LANE(active, l)) continue;
+    const TraceHit one = {LANE(h.t, l), LANE(h.b1, l), LANE(h.b2, l), LANE(h.triangle, l)};
+    hit[LANE(p, l)] = stored_hit(one);
+  }
+#else
+  intersect_lanes(nodes, blocks, p, active, ray_org, ray_dir, hit);
+#endif
+}
+
 #if !defined(FH_MEGAKERNEL)  // the megakernel calls the stage function itself
 // The intersect stage: closest hit for the paths in the current ray queue (parity picks
 // its length).

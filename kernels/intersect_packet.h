@@ -13,18 +13,19 @@
 
 #include "intersect.h"
 
-// The rays' constants as lanes. The watertight test's axis order (kx, ky, kz) must be the
-// same for every ray of a packet: its components are then loaded once per triangle.
+// The rays' constants as lanes. The watertight test's axis order (kx, ky, kz: 0 for x, 1 for
+// y, 2 for z) is each lane's own; where every lane shares it (`uniform`) it is also kept as
+// scalars, so a triangle's components load once for all lanes, and otherwise each lane
+// picks its own three (packets of incoherent rays, on small trees).
 typedef struct {
   float8 org_lo_x, org_lo_y, org_lo_z, org_hi_x, org_hi_y, org_hi_z;
   float8 inv_x, inv_y, inv_z;
   float8 sx, sy, sz, ox, oy, oz;
   float8 t_min;
+  int8 lane_kx, lane_ky, lane_kz;
   int kx, ky, kz;
+  bool uniform;
 } RayPacket;
-
-// Lane for lane x, y or z as k (the same for every lane) is 0, 1 or 2.
-FH_INLINE float8 axis_lanes(float8 x, float8 y, float8 z, int k) { return k == 0 ? x : (k == 1 ? y : z); }
 
 // Slab-test constants of one axis for all lanes, as precompute_ray makes them.
 FH_INLINE void slab_lanes(float8 o, float8 d, float8* org_lo, float8* org_hi, float8* inv) {
@@ -36,10 +37,42 @@ FH_INLINE void slab_lanes(float8 o, float8 d, float8* org_lo, float8* org_hi, fl
   *org_hi = select(o, o - eps, flat);
 }
 
-// precompute_ray for all lanes at once (the same operations, so the same bits). Lanes at or
-// past `count` repeat the last ray; the caller leaves them out. Returns false where the
-// rays' axis orders differ.
-FH_INLINE bool make_packet(const float3* org, const float3* dir, int count, const float* t_min, RayPacket* p) {
+// precompute_ray for ray l in lane l, all lanes at once (the same operations, so the same
+// bits).
+FH_INLINE void make_packet_lanes(float8 ox, float8 oy, float8 oz, float8 dx, float8 dy, float8 dz, float8 t_min,
+                                 RayPacket* p) {
+  const float8 ax = fabs(dx), ay = fabs(dy), az = fabs(dz);
+  const int8 two = (int8)(2), zero = (int8)(0);
+  const int8 kz = select(select(two, (int8)(1), ay > az), select(two, zero, ax > az), ax > ay);
+  int8 kx = select(kz + 1, zero, kz == two);
+  int8 ky = select(kx + 1, zero, kx == two);
+  const float8 along = component8(dx, dy, dz, kz);
+  const int8 down = along < (float8)(0.0f);  // keep the sheared triangle's winding
+  const int8 swapped = kx;
+  kx = select(kx, ky, down);
+  ky = select(ky, swapped, down);
+  p->lane_kx = kx;
+  p->lane_ky = ky;
+  p->lane_kz = kz;
+  p->kx = kx.s0;
+  p->ky = ky.s0;
+  p->kz = kz.s0;
+  p->uniform = all_lanes((kx == (int8)(p->kx)) & (ky == (int8)(p->ky)) & (kz == (int8)(p->kz)));
+  p->sx = component8(dx, dy, dz, kx) / along;
+  p->sy = component8(dx, dy, dz, ky) / along;
+  p->sz = 1.0f / along;
+  p->ox = component8(ox, oy, oz, kx);
+  p->oy = component8(ox, oy, oz, ky);
+  p->oz = component8(ox, oy, oz, kz);
+  slab_lanes(ox, dx, &p->org_lo_x, &p->org_hi_x, &p->inv_x);
+  slab_lanes(oy, dy, &p->org_lo_y, &p->org_hi_y, &p->inv_y);
+  slab_lanes(oz, dz, &p->org_lo_z, &p->org_hi_z, &p->inv_z);
+  p->t_min = t_min;
+}
+
+// make_packet_lanes for rays from arrays; lanes at or past `count` repeat the last ray (the
+// caller leaves them out).
+FH_INLINE void make_packet(const float3* org, const float3* dir, int count, const float* t_min, RayPacket* p) {
   float a[7][FH_PACKET];
   for (int l = 0; l < FH_PACKET; ++l) {
     const int k = min(l, count - 1);
@@ -51,35 +84,8 @@ FH_INLINE bool make_packet(const float3* org, const float3* dir, int count, cons
     a[5][l] = dir[k].z;
     a[6][l] = t_min[k];
   }
-  const float8 ox = vload8(0, a[0]), oy = vload8(0, a[1]), oz = vload8(0, a[2]);
-  const float8 dx = vload8(0, a[3]), dy = vload8(0, a[4]), dz = vload8(0, a[5]);
-  const float8 ax = fabs(dx), ay = fabs(dy), az = fabs(dz);
-  const int8 kz = select(select((int8)(2), (int8)(1), ay > az), select((int8)(2), (int8)(0), ax > az), ax > ay);
-  const int kz0 = kz.s0;
-  const float8 d_kz = axis_lanes(dx, dy, dz, kz0);
-  const int8 down = d_kz < (float8)(0.0f);
-  if (!all_lanes(kz == (int8)(kz0)) || (any_lane(down) && !all_lanes(down))) return false;
-  int kx = kz0 == 2 ? 0 : kz0 + 1;
-  int ky = kx == 2 ? 0 : kx + 1;
-  if (down.s0) {  // keep the sheared triangle's winding, as precompute_ray does
-    const int t = kx;
-    kx = ky;
-    ky = t;
-  }
-  p->kx = kx;
-  p->ky = ky;
-  p->kz = kz0;
-  p->sx = axis_lanes(dx, dy, dz, kx) / d_kz;
-  p->sy = axis_lanes(dx, dy, dz, ky) / d_kz;
-  p->sz = 1.0f / d_kz;
-  p->ox = axis_lanes(ox, oy, oz, kx);
-  p->oy = axis_lanes(ox, oy, oz, ky);
-  p->oz = axis_lanes(ox, oy, oz, kz0);
-  slab_lanes(ox, dx, &p->org_lo_x, &p->org_hi_x, &p->inv_x);
-  slab_lanes(oy, dy, &p->org_lo_y, &p->org_hi_y, &p->inv_y);
-  slab_lanes(oz, dz, &p->org_lo_z, &p->org_hi_z, &p->inv_z);
-  p->t_min = vload8(0, a[6]);
-  return true;
+  make_packet_lanes(vload8(0, a[0]), vload8(0, a[1]), vload8(0, a[2]), vload8(0, a[3]), vload8(0, a[4]),
+                    vload8(0, a[5]), vload8(0, a[6]), p);
 }
 
 // The near distance of child `c` for each ray, +INFINITY where the ray misses it or no
@@ -130,6 +136,22 @@ typedef struct {
   int8 triangle;  // BVH-order index, -1 while none
 } PacketHits;
 
+// Vertex `vertex` of a leaf's triangle j in each lane's axis order (x: kx, y: ky, z: kz).
+FH_INLINE void packet_vertex(const RayPacket* p, __global const TriangleBlock8* block, int vertex, int j, float8* x,
+                             float8* y, float8* z) {
+  if (p->uniform) {
+    *x = (float8)(block->v[vertex][p->kx][j]);
+    *y = (float8)(block->v[vertex][p->ky][j]);
+    *z = (float8)(block->v[vertex][p->kz][j]);
+    return;
+  }
+  const float8 vx = (float8)(block->v[vertex][0][j]), vy = (float8)(block->v[vertex][1][j]),
+               vz = (float8)(block->v[vertex][2][j]);
+  *x = component8(vx, vy, vz, p->lane_kx);
+  *y = component8(vx, vy, vz, p->lane_ky);
+  *z = component8(vx, vy, vz, p->lane_kz);
+}
+
 // The leaf's triangles one by one, each tested against all the rays: the watertight test of
 // intersect_block, lane for lane the same arithmetic. Any-hit rays that are hit are done:
 // their t becomes -INFINITY.
@@ -138,11 +160,12 @@ FH_INLINE void packet_intersect_block(const RayPacket* p, __global const Triangl
   for (int j = 0; j < 8; ++j) {
     const int id = block->id[j];
     if (id < 0) break;  // empty lanes come last
-    const WatertightLanes e = watertight_lanes(
-        (float8)(block->v[0][p->kx][j]), (float8)(block->v[0][p->ky][j]), (float8)(block->v[0][p->kz][j]),
-        (float8)(block->v[1][p->kx][j]), (float8)(block->v[1][p->ky][j]), (float8)(block->v[1][p->kz][j]),
-        (float8)(block->v[2][p->kx][j]), (float8)(block->v[2][p->ky][j]), (float8)(block->v[2][p->kz][j]), p->ox,
-        p->oy, p->oz, p->sx, p->sy, p->sz, p->t_min, h->t);
+    float8 x0, y0, z0, x1, y1, z1, x2, y2, z2;
+    packet_vertex(p, block, 0, j, &x0, &y0, &z0);
+    packet_vertex(p, block, 1, j, &x1, &y1, &z1);
+    packet_vertex(p, block, 2, j, &x2, &y2, &z2);
+    const WatertightLanes e = watertight_lanes(x0, y0, z0, x1, y1, z1, x2, y2, z2, p->ox, p->oy, p->oz, p->sx, p->sy,
+                                               p->sz, p->t_min, h->t);
     const int8 maybe = e.maybe;
     if (!any_lane(maybe)) continue;
     const float8 quotient = e.t_scaled / e.det;
@@ -159,19 +182,13 @@ FH_INLINE void packet_intersect_block(const RayPacket* p, __global const Triangl
   }
 }
 
-// Traces rays org[l] + t dir[l], t in [t_min[l], t_max[l]), for l < count (1..8), into
-// hit[l] as trace_ray would (any-hit queries: some occluder's index, where find_occluder
-// finds one, and t_max). Returns false, tracing nothing, where the rays' axis orders
-// differ (make_packet): the caller then traces them one by one.
-FH_INLINE bool trace_packet(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, const float3* org,
-                            const float3* dir, const float* t_min, const float* t_max, int count, bool any_hit,
-                            TraceHit* hit) {
-  RayPacket p;
-  if (!make_packet(org, dir, count, t_min, &p)) return false;
-  float end[FH_PACKET];
-  for (int l = 0; l < FH_PACKET; ++l) end[l] = l < count ? t_max[l] : -INFINITY;
+// The packet's rays, lane l on [t_min, t_end[l]) (t_end -INFINITY: a lane to leave out),
+// traced together: closest hits, or for any-hit queries some occluder (h.t then -INFINITY
+// where one is found). h.triangle is -1 where there is none.
+FH_INLINE PacketHits trace_packet_lanes(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
+                                        const RayPacket* p, float8 t_end, bool any_hit) {
   PacketHits h;
-  h.t = vload8(0, end);
+  h.t = t_end;
   h.b1 = h.b2 = (float8)(0.0f);
   h.triangle = (int8)(-1);
   int stack_node[FH_TRAVERSAL_STACK];
@@ -182,10 +199,10 @@ FH_INLINE bool trace_packet(__global const Bvh8Node* nodes, __global const Trian
   for (;;) {
     if (ref >= 0) {
       __global const Bvh8Node* node = nodes + ref;
-      ref = packet_order_children(&p, node, h.t, stack_node, stack_t, &sp);
+      ref = packet_order_children(p, node, h.t, stack_node, stack_t, &sp);
       if (ref != 0) continue;
     } else {
-      packet_intersect_block(&p, blocks + ~ref, &h, any_hit);
+      packet_intersect_block(p, blocks + ~ref, &h, any_hit);
       reach = max_lane(h.t);
       if (reach == -INFINITY) break;  // every any-hit ray is occluded
     }
@@ -199,6 +216,20 @@ FH_INLINE bool trace_packet(__global const Bvh8Node* nodes, __global const Trian
     }
     if (ref == 0) break;
   }
+  return h;
+}
+
+// Traces rays org[l] + t dir[l], t in [t_min[l], t_max[l]), for l < count (1..8), into
+// hit[l] as trace_ray would (any-hit queries: some occluder's index, where find_occluder
+// finds one, and t_max).
+FH_INLINE void trace_packet(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, const float3* org,
+                            const float3* dir, const float* t_min, const float* t_max, int count, bool any_hit,
+                            TraceHit* hit) {
+  RayPacket p;
+  make_packet(org, dir, count, t_min, &p);
+  float end[FH_PACKET];
+  for (int l = 0; l < FH_PACKET; ++l) end[l] = l < count ? t_max[l] : -INFINITY;
+  const PacketHits h = trace_packet_lanes(nodes, blocks, &p, vload8(0, end), any_hit);
   float t[FH_PACKET], b1[FH_PACKET], b2[FH_PACKET];
   int tri[FH_PACKET];
   vstore8(h.t, 0, t);
@@ -211,7 +242,6 @@ FH_INLINE bool trace_packet(__global const Bvh8Node* nodes, __global const Trian
     hit[l].b1 = b1[l];
     hit[l].b2 = b2[l];
   }
-  return true;
 }
 
 #endif

@@ -1,11 +1,12 @@
 // The rays of a work-item's lanes, set up for traversal together: with FH_LANES 8, the
 // per-ray constants of all eight (divisions included) in vector lanes, then each lane's
 // ray traversed on its own (a traversal's branches differ too much between rays to share
-// lanes). The same constants, bit for bit, as precompute_ray gives each ray alone.
+// lanes), or for coherent rays all eight as a packet. The same constants, bit for bit, as
+// precompute_ray gives each ray alone.
 #ifndef FH_LANE_RAYS_H
 #define FH_LANE_RAYS_H
 
-#include "intersect.h"
+#include "intersect_packet.h"
 #include "lanes.h"
 
 #if FH_LANES == 8
@@ -14,6 +15,16 @@ FH_INLINE void precompute_lane_rays(lvec3 org, lvec3 dir, LaneRays* rays) {
   precompute_rays8(org.x, org.y, org.z, dir.x, dir.y, dir.z, rays);
 }
 FH_INLINE RayPrecomp lane_ray(const LaneRays* rays, int l) { return ray_of_lane(rays, l); }
+
+// The eight rays as one packet (intersect_packet.h), for rays that go together (the camera
+// rays of neighbouring pixels). Lanes left out carry an active lane's ray, so their
+// arithmetic stays finite.
+FH_INLINE void make_lane_packet(lvec3 org, lvec3 dir, lfloat t_min, lmask active, RayPacket* packet) {
+  const int first = lowest_bit(lane_bits(active));
+  const lvec3 o = v3_select(active, org, v3_uniform(v3_lane(org, first)));
+  const lvec3 d = v3_select(active, dir, v3_uniform(v3_lane(dir, first)));
+  make_packet_lanes(o.x, o.y, o.z, d.x, d.y, d.z, select((lfloat)(LANE(t_min, first)), t_min, active), packet);
+}
 #else
 typedef RayPrecomp LaneRays;
 FH_INLINE void precompute_lane_rays(lvec3 org, lvec3 dir, LaneRays* rays) {

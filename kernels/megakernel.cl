@@ -54,8 +54,10 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
         start_sample(params, older, newer, entries, counters->new_first + next, p, alive, filter_table, pass_table,
                      pixel_list FH_PATH_ARGS);
         next = select(next, next + slots, alive);
+        intersect_camera_lanes(nodes, blocks, p, alive, ray_org, ray_dir, hit);
+      } else {
+        intersect_lanes(nodes, blocks, p, alive, ray_org, ray_dir, hit);
       }
-      intersect_lanes(nodes, blocks, p, alive, ray_org, ray_dir, hit);
       const ShadeOutcome o = shade_paths(params, p, alive, triangles, triangle_material, materials, light_pdf_area,
                                          normals, uvs, texels, texture_info, env_map, aovs FH_PATH_ARGS);
       if (lanes_any(o.light_sample))  // never for pt, nor without lights

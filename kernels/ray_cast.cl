@@ -44,8 +44,7 @@ __kernel void intersect_any_streams(__global const Bvh8Node* nodes, __global con
   for (int l = 0; l < count; ++l) occluded[first + l] = (int)((hit >> l) & 1ul);
 }
 
-// Rays [8 i, 8 i + 8) of the batch as a packet, or one by one where they do not share the
-// watertight test's axis order.
+// Rays [8 i, 8 i + 8) of the batch as a packet.
 FH_INLINE int trace_packet_of(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
                               __global const float4* ray_org, __global const float4* ray_dir, uint ray_count,
                               bool any_hit, TraceHit* hit) {
@@ -61,16 +60,7 @@ FH_INLINE int trace_packet_of(__global const Bvh8Node* nodes, __global const Tri
     t_min[l] = o.w;
     t_max[l] = d.w;
   }
-  if (!trace_packet(nodes, blocks, org, dir, t_min, t_max, count, any_hit, hit))
-    for (int l = 0; l < count; ++l) {
-      if (any_hit) {
-        hit[l].t = t_max[l];
-        hit[l].b1 = hit[l].b2 = 0.0f;
-        hit[l].triangle = find_occluder(nodes, blocks, org[l], dir[l], t_min[l], t_max[l]);
-      } else {
-        hit[l] = trace_ray(nodes, blocks, org[l], dir[l], t_min[l], t_max[l]);
-      }
-    }
+  trace_packet(nodes, blocks, org, dir, t_min, t_max, count, any_hit, hit);
   return count;
 }
 

@@ -149,10 +149,11 @@ class RayCasting {
   }
 
   // The packet kernels trace the same rays eight at a time: every hit, its t and
-  // barycentrics, and every any-hit answer must be the single rays' bit for bit. Rays are
-  // traced as a packet only where eight share the watertight test's axis order, so they are
-  // traced twice: in the batch's order, and sorted by that order, which puts even
-  // incoherent rays into packets.
+  // barycentrics, and every any-hit answer must be the single rays' bit for bit. A packet
+  // whose rays share the watertight test's axis order loads each triangle's components once
+  // for all; otherwise each lane picks its own. So rays are traced twice: in the batch's
+  // order (incoherent kinds mix axis orders in most packets), and sorted by that order
+  // (every packet shares one).
   void expectPacketsMatchSingleRays(const Rays& rays, const std::vector<float>& hits,
                                     const std::vector<int>& occluded, const std::string& kind) {
     std::vector<size_t> order(rays.size());
