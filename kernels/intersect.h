@@ -116,17 +116,26 @@ FH_INLINE float8 component8(float8 x, float8 y, float8 z, int8 k) {
   return select(select(z, y, k == (int8)(1)), x, k == (int8)(0));
 }
 
-FH_INLINE void precompute_rays8(float8 ox, float8 oy, float8 oz, float8 dx, float8 dy, float8 dz, RayPrecomp8* r) {
+// The watertight test's axis order of eight rays, ray l in lane l, as precompute_ray picks
+// it; *along is each ray's direction component along kz.
+FH_INLINE void axis_orders8(float8 dx, float8 dy, float8 dz, int8* kx, int8* ky, int8* kz, float8* along) {
   const float8 ax = fabs(dx), ay = fabs(dy), az = fabs(dz);
   const int8 two = (int8)(2), zero = (int8)(0);
-  const int8 kz = select(select(two, (int8)(1), ay > az), select(two, zero, ax > az), ax > ay);
-  int8 kx = select(kz + 1, zero, kz == two);
-  int8 ky = select(kx + 1, zero, kx == two);
-  const float8 along = component8(dx, dy, dz, kz);
-  const int8 down = along < (float8)(0.0f);  // keep the winding: swap kx and ky
-  const int8 swapped = kx;
-  kx = select(kx, ky, down);
-  ky = select(ky, swapped, down);
+  *kz = select(select(two, (int8)(1), ay > az), select(two, zero, ax > az), ax > ay);
+  const int8 x = select(*kz + 1, zero, *kz == two);
+  const int8 y = select(x + 1, zero, x == two);
+  *along = component8(dx, dy, dz, *kz);
+  const int8 down = *along < (float8)(0.0f);  // keep the winding: swap kx and ky
+  *kx = select(x, y, down);
+  *ky = select(y, x, down);
+}
+
+FH_INLINE void precompute_rays8(float8 ox, float8 oy, float8 oz, float8 dx, float8 dy, float8 dz, RayPrecomp8* r) {
+  const float8 ax = fabs(dx), ay = fabs(dy), az = fabs(dz);
+  const int8 zero = (int8)(0);
+  int8 kx, ky, kz;
+  float8 along;
+  axis_orders8(dx, dy, dz, &kx, &ky, &kz, &along);
   vstore8(kx, 0, r->kx);
   vstore8(ky, 0, r->ky);
   vstore8(kz, 0, r->kz);

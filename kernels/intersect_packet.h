@@ -41,16 +41,9 @@ FH_INLINE void slab_lanes(float8 o, float8 d, float8* org_lo, float8* org_hi, fl
 // bits).
 FH_INLINE void make_packet_lanes(float8 ox, float8 oy, float8 oz, float8 dx, float8 dy, float8 dz, float8 t_min,
                                  RayPacket* p) {
-  const float8 ax = fabs(dx), ay = fabs(dy), az = fabs(dz);
-  const int8 two = (int8)(2), zero = (int8)(0);
-  const int8 kz = select(select(two, (int8)(1), ay > az), select(two, zero, ax > az), ax > ay);
-  int8 kx = select(kz + 1, zero, kz == two);
-  int8 ky = select(kx + 1, zero, kx == two);
-  const float8 along = component8(dx, dy, dz, kz);
-  const int8 down = along < (float8)(0.0f);  // keep the sheared triangle's winding
-  const int8 swapped = kx;
-  kx = select(kx, ky, down);
-  ky = select(ky, swapped, down);
+  int8 kx, ky, kz;
+  float8 along;
+  axis_orders8(dx, dy, dz, &kx, &ky, &kz, &along);
   p->lane_kx = kx;
   p->lane_ky = ky;
   p->lane_kz = kz;

@@ -137,17 +137,6 @@ FH_GATHER_SCATTER(uint, luint)
 FH_GATHER_SCATTER(int, lint)
 #undef FH_GATHER_SCATTER
 
-// The xyz of float4 elements.
-FH_INLINE lvec3 gather_xyz(__global const float4* base, luint index) {
-  lvec3 r;
-  FH_FOR_LANES(l) {
-    const float4 e = base[LANE(index, l)];
-    LANE(r.x, l) = e.x;
-    LANE(r.y, l) = e.y;
-    LANE(r.z, l) = e.z;
-  }
-  return r;
-}
 FH_INLINE lvec2 gather_xy(__global const float2* base, luint index) {
   lvec2 r;
   FH_FOR_LANES(l) {
@@ -168,6 +157,11 @@ FH_INLINE lvec3 gather_xyzw(__global const float4* base, luint index, lfloat* w)
     LANE(*w, l) = e.w;
   }
   return r;
+}
+// The xyz of float4 elements.
+FH_INLINE lvec3 gather_xyz(__global const float4* base, luint index) {
+  lfloat unused;
+  return gather_xyzw(base, index, &unused);
 }
 // The w of float4 elements.
 FH_INLINE lfloat gather_w(__global const float4* base, luint index) {
