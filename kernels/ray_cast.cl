@@ -1,7 +1,9 @@
 // Ray casting over arrays of rays stored as float4 pairs (origin.xyz + tmin, direction.xyz +
 // tmax): closest hit and any hit, for fredholm bench and the tests (accel/ray_caster.cpp).
 // The *_packets kernels trace eight consecutive rays per work-item together, for coherent
-// batches; they find the same hits.
+// batches; the *_lanes and *_streams kernels take eight or FH_STREAM consecutive rays per
+// work-item too, but set them up together (the divisions in vector lanes) and trace them one
+// by one or as a stream. All find the same hits, bit for bit.
 #include "intersect_packet.h"
 #include "intersect_stream.h"
 
@@ -25,6 +27,44 @@ __kernel void intersect_any(__global const Bvh8Node* nodes, __global const Trian
   occluded[i] = find_occluder(nodes, blocks, o.xyz, d.xyz, o.w, d.w) >= 0;
 }
 
+// Rays [first, first + 8) of the batch (those before ray_count): their constants in lanes,
+// set up together as precompute_rays8 does, and their segments. Lanes past the batch repeat
+// its last ray. Returns how many are in the batch.
+FH_INLINE int load_rays8(__global const float4* ray_org, __global const float4* ray_dir, uint first,
+                         uint ray_count, RayPrecomp8* r, float* t_min, float* t_max) {
+  const int count = (int)min(ray_count - first, 8u);
+  float ox[8], oy[8], oz[8], dx[8], dy[8], dz[8];
+  for (int l = 0; l < 8; ++l) {
+    const uint i = first + (uint)min(l, count - 1);
+    const float4 o = ray_org[i], d = ray_dir[i];
+    ox[l] = o.x;
+    oy[l] = o.y;
+    oz[l] = o.z;
+    dx[l] = d.x;
+    dy[l] = d.y;
+    dz[l] = d.z;
+    t_min[l] = o.w;
+    t_max[l] = d.w;
+  }
+  precompute_rays8(vload8(0, ox), vload8(0, oy), vload8(0, oz), vload8(0, dx), vload8(0, dy), vload8(0, dz), r);
+  return count;
+}
+
+// As intersect_closest, eight consecutive rays per work-item, set up together and then
+// traced one by one (incoherent rays part ways at once: lane_rays.h).
+__kernel void intersect_closest_lanes(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
+                                      __global const float4* ray_org, __global const float4* ray_dir,
+                                      __global float4* hits, uint ray_count) {
+  const uint first = get_global_id(0) * 8;
+  if (first >= ray_count) return;
+  RayPrecomp8 r;
+  float t_min[8], t_max[8];
+  const int count = load_rays8(ray_org, ray_dir, first, ray_count, &r, t_min, t_max);
+  _Pragma("unroll 1") for (int l = 0; l < count; ++l) {
+    hits[first + l] = stored_hit(trace_precomputed(nodes, blocks, ray_of_lane(&r, l), t_min[l], t_max[l]));
+  }
+}
+
 // As intersect_any, FH_STREAM consecutive rays per work-item, traced together as a stream.
 __kernel void intersect_any_streams(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
                                     __global const float4* ray_org, __global const float4* ray_dir,
@@ -34,11 +74,10 @@ __kernel void intersect_any_streams(__global const Bvh8Node* nodes, __global con
   const int count = (int)min(ray_count - first, (uint)FH_STREAM);
   RayPrecomp r[FH_STREAM];
   float t_min[FH_STREAM], t_max[FH_STREAM];
-  for (int l = 0; l < count; ++l) {
-    const float4 o = ray_org[first + l], d = ray_dir[first + l];
-    r[l] = precompute_ray(o.xyz, d.xyz);
-    t_min[l] = o.w;
-    t_max[l] = d.w;
+  for (int g = 0; g < count; g += 8) {
+    RayPrecomp8 eight;
+    const int n = load_rays8(ray_org, ray_dir, first + (uint)g, ray_count, &eight, t_min + g, t_max + g);
+    for (int l = 0; l < n; ++l) r[g + l] = ray_of_lane(&eight, l);
   }
   const ulong hit = find_occluders(nodes, blocks, r, t_min, t_max, count);
   for (int l = 0; l < count; ++l) occluded[first + l] = (int)((hit >> l) & 1ul);

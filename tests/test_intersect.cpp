@@ -121,7 +121,7 @@ class RayCasting {
   // Traces `rays` with both kernels and checks every ray against the reference on two threads.
   void expectMatchesReference(const Rays& rays, const std::string& kind) {
     RayQueue q = work.upload(rays.org, rays.dir);
-    const cl::Buffer hitBuffer = work.closestHits(q);
+    const cl::Buffer hitBuffer = work.closestHits(q, RayOrder::OneByOne);
     cl::Buffer occludedBuffer =
         allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, q.count * 4ull + 4, "occluded");
     caster.intersectAny(q.org, q.dir, occludedBuffer, q.count, RayOrder::OneByOne);
@@ -130,7 +130,7 @@ class RayCasting {
     FH_CL(dc.queue.enqueueReadBuffer(occludedBuffer, CL_TRUE, 0, q.count * 4ull, occluded.data()));
 
     expectPacketsMatchSingleRays(rays, hits, occluded, kind);
-    expectStreamsMatchSingleRays(rays, occluded, kind);
+    expectBatchesMatchSingleRays(rays, hits, occluded, kind);
 
     const size_t half = rays.size() / 2;
     auto second = std::async(std::launch::async, checkRays, std::cref(scene), std::cref(bvh), std::cref(rays),
@@ -196,19 +196,21 @@ class RayCasting {
                           << ph[4 * first] << ", occluded " << occluded[order[first]] << " vs " << po[first];
   }
 
-  // Any-hit streams (FH_STREAM rays to a work-item) must give every ray the single rays'
-  // answer: in the batch's order, and shuffled, so that each stream's rays part ways at the
-  // root, and a batch that ends in a part-filled stream.
-  void expectStreamsMatchSingleRays(const Rays& rays, const std::vector<int>& occluded, const std::string& kind) {
+  // The CPU's kernels for incoherent batches, closest hits eight rays to a work-item and
+  // any-hit streams FH_STREAM rays to a work-item, must give every ray the single rays'
+  // answer, bit for bit: in the batch's order, and shuffled, so that each stream's rays part
+  // ways at the root, and a batch that ends in part-filled work-items.
+  void expectBatchesMatchSingleRays(const Rays& rays, const std::vector<float>& hits, const std::vector<int>& occluded,
+                                    const std::string& kind) {
     std::vector<size_t> order(rays.size());
     for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-    expectStreamsMatchSingleRays(rays, order, occluded, kind + ", streams in the batch's order");
+    expectBatchesMatchSingleRays(rays, order, hits, occluded, kind + ", batch order");
     std::shuffle(order.begin(), order.end(), std::mt19937(11));
     order.resize(order.size() - std::min<size_t>(order.size() / 2, FH_STREAM / 2 + 1));
-    expectStreamsMatchSingleRays(rays, order, occluded, kind + ", streams shuffled");
+    expectBatchesMatchSingleRays(rays, order, hits, occluded, kind + ", shuffled");
   }
 
-  void expectStreamsMatchSingleRays(const Rays& rays, const std::vector<size_t>& order,
+  void expectBatchesMatchSingleRays(const Rays& rays, const std::vector<size_t>& order, const std::vector<float>& hits,
                                     const std::vector<int>& occluded, const std::string& kind) {
     Rays sorted;
     for (size_t i : order) {
@@ -221,12 +223,18 @@ class RayCasting {
     caster.intersectAny(q.org, q.dir, streamOccluded, q.count, RayOrder::Incoherent);
     std::vector<int> so(q.count);
     FH_CL(dc.queue.enqueueReadBuffer(streamOccluded, CL_TRUE, 0, q.count * 4ull, so.data()));
-    size_t differ = 0, first = 0;
-    for (size_t k = 0; k < q.count; ++k)
-      if (so[k] != occluded[order[k]]) first = differ++ ? first : k;
-    EXPECT_EQ(differ, 0u) << kind << ": streams differ from single rays on " << differ << " of " << q.count
-                          << " rays; first: ray " << order[first] << ", occluded " << occluded[order[first]]
-                          << " vs " << so[first];
+    const std::vector<float> lh = work.readFloat4(work.closestHits(q, RayOrder::Incoherent), q.count);
+    size_t streamsDiffer = 0, firstStream = 0, lanesDiffer = 0, firstLane = 0;
+    for (size_t k = 0; k < q.count; ++k) {
+      if (so[k] != occluded[order[k]]) firstStream = streamsDiffer++ ? firstStream : k;
+      if (std::memcmp(&lh[4 * k], &hits[4 * order[k]], 16) != 0) firstLane = lanesDiffer++ ? firstLane : k;
+    }
+    EXPECT_EQ(streamsDiffer, 0u) << kind << ": streams differ from single rays on " << streamsDiffer << " of "
+                                 << q.count << " rays; first: ray " << order[firstStream] << ", occluded "
+                                 << occluded[order[firstStream]] << " vs " << so[firstStream];
+    EXPECT_EQ(lanesDiffer, 0u) << kind << ": closest hits eight to a work-item differ from single rays on "
+                               << lanesDiffer << " of " << q.count << " rays; first: ray " << order[firstLane]
+                               << ", t " << hits[4 * order[firstLane]] << " vs " << lh[4 * firstLane];
   }
 
   Rays download(const RayQueue& q) {

@@ -23,6 +23,7 @@ RayCaster::RayCaster(DeviceContext& dc, const Bvh& bvh) : dc_(dc), bvh_(dc, bvh)
   closest_ = createKernel(program, "intersect_closest");
   any_ = createKernel(program, "intersect_any");
   closestPackets_ = createKernel(program, "intersect_closest_packets");
+  closestLanes_ = createKernel(program, "intersect_closest_lanes");
   anyPackets_ = createKernel(program, "intersect_any_packets");
   anyStreams_ = createKernel(program, "intersect_any_streams");
 }
@@ -34,26 +35,27 @@ size_t workItems(unsigned count, unsigned perItem) { return (count + perItem - 1
 
 void RayCaster::intersectClosest(const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& hits,
                                  unsigned count, RayOrder order, cl::Event* event) {
-  const bool packets = order == RayOrder::Coherent;
-  cl::Kernel& kernel = packets ? closestPackets_ : closest_;
-  setKernelArgs(kernel, nodes(), blocks(), org, dir, hits, count);
-  launch(dc_, kernel, workItems(count, packets ? FH_PACKET : 1),
-         packets ? "intersect_closest_packets" : "intersect_closest", event);
+  Choice c{&closest_, 1, "intersect_closest"};
+  if (order == RayOrder::Coherent)
+    c = {&closestPackets_, FH_PACKET, "intersect_closest_packets"};
+  else if (order == RayOrder::Incoherent && dc_.info.type == "cpu")
+    c = {&closestLanes_, 8, "intersect_closest_lanes"};
+  launchChoice(c, org, dir, hits, count, event);
 }
 
 void RayCaster::intersectAny(const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& occluded,
                              unsigned count, RayOrder order, cl::Event* event) {
-  struct Choice {
-    cl::Kernel* kernel;
-    unsigned raysPerItem;
-    const char* name;
-  };
   Choice c{&any_, 1, "intersect_any"};
   if (order == RayOrder::Coherent)
     c = {&anyPackets_, FH_PACKET, "intersect_any_packets"};
   else if (order == RayOrder::Incoherent && dc_.info.type == "cpu")
     c = {&anyStreams_, FH_STREAM, "intersect_any_streams"};
-  setKernelArgs(*c.kernel, nodes(), blocks(), org, dir, occluded, count);
+  launchChoice(c, org, dir, occluded, count, event);
+}
+
+void RayCaster::launchChoice(const Choice& c, const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& out,
+                             unsigned count, cl::Event* event) {
+  setKernelArgs(*c.kernel, nodes(), blocks(), org, dir, out, count);
   launch(dc_, *c.kernel, workItems(count, c.raysPerItem), c.name, event);
 }
 

@@ -30,10 +30,11 @@ class DeviceBvh {
 
 // How a batch of rays is laid out, which picks the kernels that trace it. Coherent batches
 // (camera rays in pixel order, where neighbours in the batch take nearly the same path
-// through the tree) are traced eight at a time as packets. Otherwise closest hits are traced
-// one ray per work-item, and on a CPU any-hit queries as streams of FH_STREAM consecutive
-// rays (kernels/intersect_stream.h: a stream's private state is too large for a GPU's
-// work-items). OneByOne traces every ray on its own, as the path tracer's stages do.
+// through the tree) are traced eight at a time as packets. Otherwise, on a CPU, closest hits
+// are traced eight consecutive rays per work-item, their constants set up together in
+// vector lanes, and any-hit queries as streams of FH_STREAM consecutive rays
+// (kernels/intersect_stream.h: a stream's private state is too large for a GPU's
+// work-items); on a GPU one ray per work-item. OneByOne traces every ray on its own, as the path tracer's stages do.
 // Whichever kernels, the answers are the same, bit for bit.
 enum class RayOrder { Incoherent, Coherent, OneByOne };
 
@@ -57,10 +58,19 @@ class RayCaster {
   const ProgramBuildInfo& buildInfo() const { return buildInfo_; }
 
  private:
+  // A kernel over arrays of rays, and how many rays each of its work-items takes.
+  struct Choice {
+    cl::Kernel* kernel;
+    unsigned raysPerItem;
+    const char* name;
+  };
+  void launchChoice(const Choice& c, const cl::Buffer& org, const cl::Buffer& dir, const cl::Buffer& out,
+                    unsigned count, cl::Event* event);
+
   DeviceContext& dc_;
   DeviceBvh bvh_;
   ProgramBuildInfo buildInfo_;
-  cl::Kernel closest_, any_, closestPackets_, anyPackets_, anyStreams_;
+  cl::Kernel closest_, any_, closestPackets_, anyPackets_, anyStreams_, closestLanes_;
 };
 
 }  // namespace fh

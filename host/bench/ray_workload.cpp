@@ -51,9 +51,9 @@ RayQueue RayWorkload::primary(const Camera& camera, int width, int height, unsig
   return q;
 }
 
-cl::Buffer RayWorkload::closestHits(const RayQueue& rays) {
+cl::Buffer RayWorkload::closestHits(const RayQueue& rays, RayOrder order) {
   cl::Buffer hits = allocateBuffer(dc_.context, dc_.info.device, CL_MEM_READ_WRITE, rays.count * 16ull, "hits");
-  caster_.intersectClosest(rays.org, rays.dir, hits, rays.count);
+  caster_.intersectClosest(rays.org, rays.dir, hits, rays.count, order);
   return hits;
 }
 

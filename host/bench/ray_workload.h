@@ -24,7 +24,7 @@ class RayWorkload {
   RayWorkload(DeviceContext& dc, const Scene& scene, const Bvh& bvh, RayCaster& caster);
 
   RayQueue primary(const Camera& camera, int width, int height, unsigned seed);
-  cl::Buffer closestHits(const RayQueue& rays);
+  cl::Buffer closestHits(const RayQueue& rays, RayOrder order = RayOrder::Incoherent);
   RayQueue bounce(const RayQueue& from, const cl::Buffer& hits, unsigned seed);
   // Shadow rays to uniform points on the scene's emitters; an empty queue without any.
   RayQueue shadow(const RayQueue& from, const cl::Buffer& hits, unsigned seed);
