@@ -1,6 +1,7 @@
 // The path tracer's intersect stage: the closest hit of each path's ray (ray casting over
 // plain arrays of rays, for the bench and the tests, is ray_cast.cl).
 #include "lane_rays.h"
+#include "path_state.h"
 
 // Closest hit for the ray of path slot p: reads ray_org/ray_dir, writes hit.
 FH_INLINE void intersect_slot(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, uint p,
@@ -12,8 +13,8 @@ FH_INLINE void intersect_slot(__global const Bvh8Node* nodes, __global const Tri
 // Closest hits for the rays of the lanes' path slots p where `active` (the megakernel's
 // eight paths): intersect_slot for each, their rays set up together.
 FH_INLINE void intersect_lanes(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, luint p,
-                               lmask active, __global const float4* ray_org, __global const float4* ray_dir,
-                               __global float4* hit) {
+                               lmask active, FH_PATH_SPACE const float4* ray_org, FH_PATH_SPACE const float4* ray_dir,
+                               FH_PATH_SPACE float4* hit) {
   lfloat t_min, t_max;
   const lvec3 org = gather_xyzw(ray_org, p, &t_min), dir = gather_xyzw(ray_dir, p, &t_max);
   LaneRays rays;
@@ -29,8 +30,8 @@ FH_INLINE void intersect_lanes(__global const Bvh8Node* nodes, __global const Tr
 // lanes, neighbouring pixels): they take nearly the same path through the tree, and one
 // traversal serves all eight (intersect_packet.h: the same hits, bit for bit).
 FH_INLINE void intersect_camera_lanes(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, luint p,
-                                      lmask active, __global const float4* ray_org, __global const float4* ray_dir,
-                                      __global float4* hit) {
+                                      lmask active, FH_PATH_SPACE const float4* ray_org, FH_PATH_SPACE const float4* ray_dir,
+                                      FH_PATH_SPACE float4* hit) {
 #if FH_LANES == 8
   lfloat t_min, t_max;
   const lvec3 org = gather_xyzw(ray_org, p, &t_min), dir = gather_xyzw(ray_dir, p, &t_max);

@@ -120,21 +120,68 @@ FH_INLINE lvec3 v3_select(lmask m, lvec3 if_true, lvec3 if_false) {
 
 // ---- Gathers and scatters: per-path and per-triangle data by index ----
 
+// With FH_PRIVATE_PATHS (the CPU megakernel, megakernel.cl), the path state is each
+// work-item's own private arrays rather than global buffers, so the gathers and scatters
+// come in both address spaces (overloaded; the other programs keep plain functions).
+#if defined(FH_MEGAKERNEL) && FH_LANES > 1
+#define FH_PRIVATE_PATHS
+#define FH_ACCESS FH_INLINE __attribute__((overloadable))
+#else
+#define FH_ACCESS FH_INLINE
+#endif
+
 // gather_float, gather_uint, gather_int: base[index] for each lane's index, and
 // scatter_float, scatter_uint, scatter_int: base[index] = v where m is set.
-#define FH_GATHER_SCATTER(element, lanes_type)                                                   \
-  FH_INLINE lanes_type gather_##element(__global const element* base, luint index) {            \
-    lanes_type r;                                                                               \
-    FH_FOR_LANES(l) LANE(r, l) = base[LANE(index, l)];                                          \
-    return r;                                                                                   \
-  }                                                                                             \
-  FH_INLINE void scatter_##element(__global element* base, luint index, lanes_type v, lmask m) { \
-    FH_FOR_LANES(l)                                                                             \
-    if (LANE(m, l)) base[LANE(index, l)] = LANE(v, l);                                          \
+#define FH_GATHER_SCATTER(space, element, lanes_type)                                         \
+  FH_ACCESS lanes_type gather_##element(space const element* base, luint index) {             \
+    lanes_type r;                                                                             \
+    FH_FOR_LANES(l) LANE(r, l) = base[LANE(index, l)];                                        \
+    return r;                                                                                 \
+  }                                                                                           \
+  FH_ACCESS void scatter_##element(space element* base, luint index, lanes_type v, lmask m) { \
+    FH_FOR_LANES(l)                                                                           \
+    if (LANE(m, l)) base[LANE(index, l)] = LANE(v, l);                                        \
   }
-FH_GATHER_SCATTER(float, lfloat)
-FH_GATHER_SCATTER(uint, luint)
-FH_GATHER_SCATTER(int, lint)
+
+// The xyz of float4 elements, and their w into *w: each element read once (gather_xyzw);
+// their xyz (gather_xyz) or w (gather_w); and where m is set, base[index] = (v, w).
+#define FH_FLOAT4_GATHER_SCATTER(space)                                                          \
+  FH_ACCESS lvec3 gather_xyzw(space const float4* base, luint index, lfloat* w) {                \
+    lvec3 r;                                                                                     \
+    FH_FOR_LANES(l) {                                                                            \
+      const float4 e = base[LANE(index, l)];                                                     \
+      LANE(r.x, l) = e.x;                                                                        \
+      LANE(r.y, l) = e.y;                                                                        \
+      LANE(r.z, l) = e.z;                                                                        \
+      LANE(*w, l) = e.w;                                                                         \
+    }                                                                                            \
+    return r;                                                                                    \
+  }                                                                                              \
+  FH_ACCESS lvec3 gather_xyz(space const float4* base, luint index) {                            \
+    lfloat unused;                                                                               \
+    return gather_xyzw(base, index, &unused);                                                    \
+  }                                                                                              \
+  FH_ACCESS lfloat gather_w(space const float4* base, luint index) {                             \
+    lfloat r;                                                                                    \
+    FH_FOR_LANES(l) LANE(r, l) = base[LANE(index, l)].w;                                         \
+    return r;                                                                                    \
+  }                                                                                              \
+  FH_ACCESS void scatter_xyzw(space float4* base, luint index, lvec3 v, lfloat w, lmask m) {     \
+    FH_FOR_LANES(l)                                                                              \
+    if (LANE(m, l)) base[LANE(index, l)] = (float4)(LANE(v.x, l), LANE(v.y, l), LANE(v.z, l), LANE(w, l)); \
+  }
+
+#define FH_ALL_GATHER_SCATTER(space)         \
+  FH_GATHER_SCATTER(space, float, lfloat)    \
+  FH_GATHER_SCATTER(space, uint, luint)      \
+  FH_GATHER_SCATTER(space, int, lint)        \
+  FH_FLOAT4_GATHER_SCATTER(space)
+FH_ALL_GATHER_SCATTER(__global)
+#ifdef FH_PRIVATE_PATHS
+FH_ALL_GATHER_SCATTER(__private)
+#endif
+#undef FH_ALL_GATHER_SCATTER
+#undef FH_FLOAT4_GATHER_SCATTER
 #undef FH_GATHER_SCATTER
 
 FH_INLINE lvec2 gather_xy(__global const float2* base, luint index) {
@@ -145,34 +192,6 @@ FH_INLINE lvec2 gather_xy(__global const float2* base, luint index) {
     LANE(r.y, l) = e.y;
   }
   return r;
-}
-// The xyz of float4 elements, and their w into *w: each element read once.
-FH_INLINE lvec3 gather_xyzw(__global const float4* base, luint index, lfloat* w) {
-  lvec3 r;
-  FH_FOR_LANES(l) {
-    const float4 e = base[LANE(index, l)];
-    LANE(r.x, l) = e.x;
-    LANE(r.y, l) = e.y;
-    LANE(r.z, l) = e.z;
-    LANE(*w, l) = e.w;
-  }
-  return r;
-}
-// The xyz of float4 elements.
-FH_INLINE lvec3 gather_xyz(__global const float4* base, luint index) {
-  lfloat unused;
-  return gather_xyzw(base, index, &unused);
-}
-// The w of float4 elements.
-FH_INLINE lfloat gather_w(__global const float4* base, luint index) {
-  lfloat r;
-  FH_FOR_LANES(l) LANE(r, l) = base[LANE(index, l)].w;
-  return r;
-}
-// Where m is set: base[index] = (v, w).
-FH_INLINE void scatter_xyzw(__global float4* base, luint index, lvec3 v, lfloat w, lmask m) {
-  FH_FOR_LANES(l)
-    if (LANE(m, l)) base[LANE(index, l)] = (float4)(LANE(v.x, l), LANE(v.y, l), LANE(v.z, l), LANE(w, l));
 }
 
 // Lane l of v as a float3 (for scalar code: ray traversal).

@@ -11,6 +11,16 @@
 #include "shade.cl"
 #include "shadow_connect.cl"
 
+#ifdef FH_PRIVATE_PATHS
+// The host binds the path state's buffers to every path-tracing program; this one keeps the
+// state of its lanes in private arrays instead (below), and leaves the buffers alone.
+#define FH_PATH_BUFFER(type, name, bytes) , __global type* name##_buffer
+#define FH_PATH_BUFFERS FH_PATH_FIELDS(FH_PATH_BUFFER)
+#define FH_PATH_PRIVATE(type, name, bytes) type name[FH_LANES];
+#else
+#define FH_PATH_BUFFERS FH_PATH_PARAMS
+#endif
+
 __kernel void megakernel(RenderParams params, volatile __global WavefrontCounters* counters, uint parity,
                          __global const uint* free_list, __global const float* filter_table,
                          __global const uint* pass_table, __global const uint* pixel_list,
@@ -22,7 +32,7 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
                          __global const float2* uvs, __global const uint* texels,
                          __global const uint4* texture_info, __global const float* env_map,
                          __global float4* pass_buffer,
-                         __global float4* aovs FH_PATH_PARAMS) {
+                         __global float4* aovs FH_PATH_BUFFERS) {
   // The work-group's books, added to the device's once at the end (see queue_append_each):
   // samples finished per pass slot, then bounce rays, shadow rays and non-finite samples.
   volatile __local uint finished_in_slot[FH_MAX_PASS_SLOTS], totals[3];
@@ -39,7 +49,16 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
   const luint g = lane_positions(get_global_id(0) * FH_LANES);
   const lmask owns_slot = g < slots && g < count;
   if (lanes_any(owns_slot)) {
+#ifdef FH_PRIVATE_PATHS
+    // Lane l's path state is element l of the work-item's own arrays, next to its other
+    // private values, instead of a global slot's: the accesses need no addresses computed
+    // from slot indices, and most name their lane at compile time, so the compiler can keep
+    // those in registers.
+    FH_PATH_FIELDS(FH_PATH_PRIVATE)
+    const luint p = lane_positions(0);
+#else
     const luint p = gather_uint(free_list, slots - 1 - select((luint)(0), g, owns_slot));
+#endif
     luint next = g;  // the lane's next sample
     lmask alive = lanes_mask(false);
     uint bounce_rays = 0, shadow_rays = 0, nonfinite = 0;

@@ -48,13 +48,21 @@
 #ifdef __OPENCL_VERSION__
 #include "ray.h"
 
-#define FH_PATH_PARAM(type, name, bytes) , __global type* name
+// Where the path state lives: global buffers, or with FH_PRIVATE_PATHS (lanes.h) the
+// megakernel's private arrays.
+#ifdef FH_PRIVATE_PATHS
+#define FH_PATH_SPACE __private
+#else
+#define FH_PATH_SPACE __global
+#endif
+#define FH_PATH_PARAM(type, name, bytes) , FH_PATH_SPACE type* name
 #define FH_PATH_ARG(type, name, bytes) , name
 // Appended to a kernel's or a stage function's parameter list:
 // `__kernel void k(int a FH_PATH_PARAMS)`, and to a call that passes them on: `f(a FH_PATH_ARGS)`.
 #define FH_PATH_PARAMS FH_PATH_FIELDS(FH_PATH_PARAM)
 #define FH_PATH_ARGS FH_PATH_FIELDS(FH_PATH_ARG)
-#define FH_SHADOW_PARAMS FH_SHADOW_FIELDS(FH_PATH_PARAM)
+#define FH_SHADOW_PARAM(type, name, bytes) , __global type* name
+#define FH_SHADOW_PARAMS FH_SHADOW_FIELDS(FH_SHADOW_PARAM)
 #define FH_SHADOW_ARGS FH_SHADOW_FIELDS(FH_PATH_ARG)
 
 // One light-sample request per lane, as shade makes it and shadow_connect uses it; the
