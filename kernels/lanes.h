@@ -132,31 +132,33 @@ FH_INLINE lvec3 v3_select(lmask m, lvec3 if_true, lvec3 if_false) {
 
 // gather_float, gather_uint, gather_int: base[index] for each lane's index, and
 // scatter_float, scatter_uint, scatter_int: base[index] = v where m is set.
-#define FH_GATHER_SCATTER(space, element, lanes_type)                                         \
-  FH_ACCESS lanes_type gather_##element(space const element* base, luint index) {             \
-    lanes_type r;                                                                             \
-    FH_FOR_LANES(l) LANE(r, l) = base[LANE(index, l)];                                        \
-    return r;                                                                                 \
-  }                                                                                           \
+#define FH_GATHER(space, element, lanes_type)                                     \
+  FH_ACCESS lanes_type gather_##element(space const element* base, luint index) { \
+    lanes_type r;                                                                 \
+    FH_FOR_LANES(l) LANE(r, l) = base[LANE(index, l)];                            \
+    return r;                                                                     \
+  }
+#define FH_SCATTER(space, element, lanes_type)                                                \
   FH_ACCESS void scatter_##element(space element* base, luint index, lanes_type v, lmask m) { \
     FH_FOR_LANES(l)                                                                           \
     if (LANE(m, l)) base[LANE(index, l)] = LANE(v, l);                                        \
   }
 
-// The xyz of float4 elements, and their w into *w: each element read once (gather_xyzw);
-// their xyz (gather_xyz) or w (gather_w); and where m is set, base[index] = (v, w).
-#define FH_FLOAT4_GATHER_SCATTER(space)                                                          \
-  FH_ACCESS lvec3 gather_xyzw(space const float4* base, luint index, lfloat* w) {                \
-    lvec3 r;                                                                                     \
-    FH_FOR_LANES(l) {                                                                            \
-      const float4 e = base[LANE(index, l)];                                                     \
-      LANE(r.x, l) = e.x;                                                                        \
-      LANE(r.y, l) = e.y;                                                                        \
-      LANE(r.z, l) = e.z;                                                                        \
-      LANE(*w, l) = e.w;                                                                         \
-    }                                                                                            \
-    return r;                                                                                    \
-  }                                                                                              \
+// The xyz of float4 elements, and their w into *w: each element read once (gather_xyzw).
+#define FH_GATHER_XYZW(space)                                                         \
+  FH_ACCESS lvec3 gather_xyzw(space const float4* base, luint index, lfloat* w) {     \
+    lvec3 r;                                                                          \
+    FH_FOR_LANES(l) {                                                                 \
+      const float4 e = base[LANE(index, l)];                                          \
+      LANE(r.x, l) = e.x;                                                             \
+      LANE(r.y, l) = e.y;                                                             \
+      LANE(r.z, l) = e.z;                                                             \
+      LANE(*w, l) = e.w;                                                              \
+    }                                                                                 \
+    return r;                                                                         \
+  }
+// Their xyz (gather_xyz) or w (gather_w); and where m is set, base[index] = (v, w).
+#define FH_FLOAT4_ACCESS(space)                                                                  \
   FH_ACCESS lvec3 gather_xyz(space const float4* base, luint index) {                            \
     lfloat unused;                                                                               \
     return gather_xyzw(base, index, &unused);                                                    \
@@ -171,18 +173,59 @@ FH_INLINE lvec3 v3_select(lmask m, lvec3 if_true, lvec3 if_false) {
     if (LANE(m, l)) base[LANE(index, l)] = (float4)(LANE(v.x, l), LANE(v.y, l), LANE(v.z, l), LANE(w, l)); \
   }
 
-#define FH_ALL_GATHER_SCATTER(space)         \
-  FH_GATHER_SCATTER(space, float, lfloat)    \
-  FH_GATHER_SCATTER(space, uint, luint)      \
-  FH_GATHER_SCATTER(space, int, lint)        \
-  FH_FLOAT4_GATHER_SCATTER(space)
-FH_ALL_GATHER_SCATTER(__global)
-#ifdef FH_PRIVATE_PATHS
-FH_ALL_GATHER_SCATTER(__private)
+#define FH_GATHERS(space)                 \
+  FH_GATHER(space, float, lfloat)         \
+  FH_GATHER(space, uint, luint)           \
+  FH_GATHER(space, int, lint)             \
+  FH_GATHER_XYZW(space)
+#define FH_SCATTERS(space)                \
+  FH_SCATTER(space, float, lfloat)        \
+  FH_SCATTER(space, uint, luint)          \
+  FH_SCATTER(space, int, lint)            \
+  FH_FLOAT4_ACCESS(space)
+
+#if FH_LANES == 8 && defined(__AVX2__)
+// Eight lanes of global data on x86: the gather instruction, one per eight 32-bit words,
+// where the portable form is eight loads and eight inserts into the vector. Its operand is
+// a flat address, which OpenCL C has no cast to; a CPU device has one address space, so the
+// global pointer goes through an integer. Its word offsets are signed 32-bit: buffers up
+// to 8 GiB, which every buffer a CPU device is given here stays under.
+typedef float fh_gather_v8sf __attribute__((vector_size(32)));
+typedef int fh_gather_v8si __attribute__((vector_size(32)));
+FH_INLINE float8 gather_words(__global const void* base, int8 word) {
+  const fh_gather_v8sf all = (fh_gather_v8sf)as_float8((int8)(-1));
+  union {
+    fh_gather_v8sf x86;
+    float8 lanes;
+  } r;
+  r.x86 = __builtin_ia32_gatherd_ps256((fh_gather_v8sf)(float8)(0.0f), (const void*)(ulong)base,
+                                       (fh_gather_v8si)word, all, 4);
+  return r.lanes;
+}
+FH_ACCESS lfloat gather_float(__global const float* base, luint index) { return gather_words(base, as_int8(index)); }
+FH_ACCESS luint gather_uint(__global const uint* base, luint index) {
+  return as_uint8(gather_words(base, as_int8(index)));
+}
+FH_ACCESS lint gather_int(__global const int* base, luint index) { return as_int8(gather_words(base, as_int8(index))); }
+FH_ACCESS lvec3 gather_xyzw(__global const float4* base, luint index, lfloat* w) {
+  const int8 word = as_int8(index) * 4;
+  *w = gather_words(base, word + 3);
+  return v3(gather_words(base, word), gather_words(base, word + 1), gather_words(base, word + 2));
+}
+#else
+FH_GATHERS(__global)
 #endif
-#undef FH_ALL_GATHER_SCATTER
-#undef FH_FLOAT4_GATHER_SCATTER
-#undef FH_GATHER_SCATTER
+FH_SCATTERS(__global)
+#ifdef FH_PRIVATE_PATHS
+FH_GATHERS(__private)
+FH_SCATTERS(__private)
+#endif
+#undef FH_GATHERS
+#undef FH_SCATTERS
+#undef FH_FLOAT4_ACCESS
+#undef FH_GATHER_XYZW
+#undef FH_SCATTER
+#undef FH_GATHER
 
 FH_INLINE lvec2 gather_xy(__global const float2* base, luint index) {
   lvec2 r;
