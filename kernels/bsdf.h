@@ -47,27 +47,28 @@ typedef struct {
   lint illum, texture;
 } MaterialLanes;
 
+// Each lane's material is a run of 32-bit words; field `offset` (in words) of every lane's
+// material is one gather (lanes.h), and a field no caller reads is never loaded.
+FH_INLINE lfloat material_float(__global const GpuMaterial* materials, luint first_word, int offset) {
+  return gather_float((__global const float*)materials + offset, first_word);
+}
+
+FH_INLINE lvec3 material_rgb(__global const GpuMaterial* materials, luint first_word, int offset) {
+  return v3(material_float(materials, first_word, offset), material_float(materials, first_word, offset + 1),
+            material_float(materials, first_word, offset + 2));
+}
+
 FH_INLINE MaterialLanes material_lanes(__global const GpuMaterial* materials, lint id) {
+  const luint first = las_uint(id) * (uint)(FH_MATERIAL_WORDS);
   MaterialLanes r;
-  FH_FOR_LANES(l) {
-    __global const GpuMaterial* m = materials + LANE(id, l);
-    LANE(r.kd.x, l) = m->kd[0];
-    LANE(r.kd.y, l) = m->kd[1];
-    LANE(r.kd.z, l) = m->kd[2];
-    LANE(r.ks.x, l) = m->ks[0];
-    LANE(r.ks.y, l) = m->ks[1];
-    LANE(r.ks.z, l) = m->ks[2];
-    LANE(r.ns, l) = m->ks[3];
-    LANE(r.tf.x, l) = m->tf[0];
-    LANE(r.tf.y, l) = m->tf[1];
-    LANE(r.tf.z, l) = m->tf[2];
-    LANE(r.ni, l) = m->tf[3];
-    LANE(r.ke.x, l) = m->ke[0];
-    LANE(r.ke.y, l) = m->ke[1];
-    LANE(r.ke.z, l) = m->ke[2];
-    LANE(r.illum, l) = m->illum;
-    LANE(r.texture, l) = m->texture;
-  }
+  r.kd = material_rgb(materials, first, FH_MATERIAL_KD);
+  r.ke = material_rgb(materials, first, FH_MATERIAL_KE);
+  r.ks = material_rgb(materials, first, FH_MATERIAL_KS);
+  r.ns = material_float(materials, first, FH_MATERIAL_NS);
+  r.tf = material_rgb(materials, first, FH_MATERIAL_TF);
+  r.ni = material_float(materials, first, FH_MATERIAL_NI);
+  r.illum = gather_int((__global const int*)materials + FH_MATERIAL_ILLUM, first);
+  r.texture = gather_int((__global const int*)materials + FH_MATERIAL_TEXTURE, first);
   return r;
 }
 

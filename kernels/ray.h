@@ -26,14 +26,18 @@ FH_INLINE lvec3 triangle_corner(__global const float4* triangles, lint t, int k)
   return gather_xyz(triangles, las_uint(3 * t + k));
 }
 
-FH_INLINE SurfacePoint surface_point(__global const float4* triangles, lint t, lfloat b1, lfloat b2) {
-  const lvec3 v0 = triangle_corner(triangles, t, 0), v1 = triangle_corner(triangles, t, 1),
-              v2 = triangle_corner(triangles, t, 2);
+// The point at barycentrics (b1, b2) of the triangle with corners v0, v1, v2.
+FH_INLINE SurfacePoint surface_point_between(lvec3 v0, lvec3 v1, lvec3 v2, lfloat b1, lfloat b2) {
   SurfacePoint s;
   s.position = v3_add(v3_add(v3_scale(v0, 1.0f - b1 - b2), v3_scale(v1, b1)), v3_scale(v2, b2));
   s.normal = v3_normalize(v3_cross(v3_sub(v1, v0), v3_sub(v2, v0)));
   s.magnitude = v3_max_component(v3_max(v3_max(v3_abs(v0), v3_abs(v1)), v3_max(v3_abs(v2), v3_abs(s.position))));
   return s;
+}
+
+FH_INLINE SurfacePoint surface_point(__global const float4* triangles, lint t, lfloat b1, lfloat b2) {
+  return surface_point_between(triangle_corner(triangles, t, 0), triangle_corner(triangles, t, 1),
+                               triangle_corner(triangles, t, 2), b1, b2);
 }
 
 // The origin for a ray leaving the surface on the side `side` (any vector on that side).

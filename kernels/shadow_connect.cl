@@ -43,7 +43,7 @@ FH_INLINE LightSample sample_light_triangle(lvec3 origin, lfloat u_pick, lvec2 u
                                            light_tri.v1, light_tri.v2);
     b = lv2(select(b.x, along.x, by_angle), select(b.y, along.y, by_angle));
   }
-  const SurfacePoint l = surface_point(triangles, lt, b.x, b.y);
+  const SurfacePoint l = surface_point_between(light_tri.v0, light_tri.v1, light_tri.v2, b.x, b.y);
   const lvec3 to_light = v3_sub(l.position, origin);
   const lfloat dist2 = v3_dot(to_light, to_light);
   LightSample ls;

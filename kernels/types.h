@@ -68,6 +68,17 @@ typedef struct {
   float tf[4];  // transmission rgb (glass illum models only), w: Ni
   int illum, texture, pad0, pad1;
 } GpuMaterial;
+// GpuMaterial's fields as offsets in 32-bit words, for gathers of one field across lanes
+// (host/device/kernel_layouts.cpp checks them against the struct).
+#define FH_MATERIAL_KD 0
+#define FH_MATERIAL_KE 4
+#define FH_MATERIAL_KS 8
+#define FH_MATERIAL_NS 11
+#define FH_MATERIAL_TF 12
+#define FH_MATERIAL_NI 15
+#define FH_MATERIAL_ILLUM 16
+#define FH_MATERIAL_TEXTURE 17
+#define FH_MATERIAL_WORDS 20
 
 // What every path-tracing stage needs to know about the render.
 typedef struct {

@@ -38,6 +38,15 @@ FH_LAYOUT(GpuMaterial, ks, 32);
 FH_LAYOUT(GpuMaterial, tf, 48);
 FH_LAYOUT(GpuMaterial, illum, 64);
 FH_LAYOUT(GpuMaterial, texture, 68);
+static_assert(sizeof(GpuMaterial) == 4 * FH_MATERIAL_WORDS, "GpuMaterial words");
+FH_LAYOUT(GpuMaterial, kd, 4 * FH_MATERIAL_KD);
+FH_LAYOUT(GpuMaterial, ke, 4 * FH_MATERIAL_KE);
+FH_LAYOUT(GpuMaterial, ks, 4 * FH_MATERIAL_KS);
+FH_LAYOUT(GpuMaterial, ks[3], 4 * FH_MATERIAL_NS);
+FH_LAYOUT(GpuMaterial, tf, 4 * FH_MATERIAL_TF);
+FH_LAYOUT(GpuMaterial, tf[3], 4 * FH_MATERIAL_NI);
+FH_LAYOUT(GpuMaterial, illum, 4 * FH_MATERIAL_ILLUM);
+FH_LAYOUT(GpuMaterial, texture, 4 * FH_MATERIAL_TEXTURE);
 
 static_assert(sizeof(RenderParams) == 144, "RenderParams");
 FH_LAYOUT(RenderParams, camera, 0);
