@@ -19,15 +19,9 @@
 
 // Texel i's radiance, and its density per unit uv area in *density.
 FH_INLINE lvec3 environment_texel(__global const float* env_map, luint i, lfloat* density) {
-  lvec3 radiance;
-  FH_FOR_LANES(l) {
-    const float4 t = vload4(LANE(i, l), env_map);
-    LANE(radiance.x, l) = t.x;
-    LANE(radiance.y, l) = t.y;
-    LANE(radiance.z, l) = t.z;
-    LANE(*density, l) = t.w;
-  }
-  return radiance;
+  const luint word = 4u * i;
+  *density = gather_float(env_map + 3, word);
+  return v3(gather_float(env_map, word), gather_float(env_map + 1, word), gather_float(env_map + 2, word));
 }
 
 // The density per solid angle of a texel's density per uv area, at sin(theta).
