@@ -18,7 +18,7 @@
 #define FH_AOV_FLOAT4S 2
 
 // The entry of path p's sample in the AOV buffers.
-FH_INLINE luint aov_entry(luint p, FH_PATH_SPACE const uint* pass_entry) {
+FH_INLINE luint aov_entry(luint p, FH_PATH_SPACE const FH_PATH_TYPE(uint)* pass_entry) {
   return FH_AOV_FLOAT4S * FH_PASS_ENTRY_INDEX(gather_uint(pass_entry, p));
 }
 

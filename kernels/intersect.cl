@@ -13,16 +13,15 @@ FH_INLINE void intersect_slot(__global const Bvh8Node* nodes, __global const Tri
 // Closest hits for the rays of the lanes' path slots p where `active` (the megakernel's
 // eight paths): intersect_slot for each, their rays set up together.
 FH_INLINE void intersect_lanes(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, luint p,
-                               lmask active, FH_PATH_SPACE const float4* ray_org, FH_PATH_SPACE const float4* ray_dir,
-                               FH_PATH_SPACE float4* hit) {
+                               lmask active, FH_PATH_SPACE const FH_PATH_TYPE(float4)* ray_org,
+                               FH_PATH_SPACE const FH_PATH_TYPE(float4)* ray_dir, FH_PATH_SPACE FH_PATH_TYPE(float4)* hit) {
   lfloat t_min, t_max;
   const lvec3 org = gather_xyzw(ray_org, p, &t_min), dir = gather_xyzw(ray_dir, p, &t_max);
   LaneRays rays;
   precompute_lane_rays(org, dir, &rays);
   FH_EACH_LANE(l) {
     if (LANE(active, l))
-      hit[LANE(p, l)] =
-          stored_hit(trace_precomputed(nodes, blocks, lane_ray(&rays, l), LANE(t_min, l), LANE(t_max, l)));
+      store_lane(hit, p, l, stored_hit(trace_precomputed(nodes, blocks, lane_ray(&rays, l), LANE(t_min, l), LANE(t_max, l))));
   }
 }
 
@@ -30,8 +29,9 @@ FH_INLINE void intersect_lanes(__global const Bvh8Node* nodes, __global const Tr
 // lanes, neighbouring pixels): they take nearly the same path through the tree, and one
 // traversal serves all eight (intersect_packet.h: the same hits, bit for bit).
 FH_INLINE void intersect_camera_lanes(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, luint p,
-                                      lmask active, FH_PATH_SPACE const float4* ray_org, FH_PATH_SPACE const float4* ray_dir,
-                                      FH_PATH_SPACE float4* hit) {
+                                      lmask active, FH_PATH_SPACE const FH_PATH_TYPE(float4)* ray_org,
+                                      FH_PATH_SPACE const FH_PATH_TYPE(float4)* ray_dir,
+                                      FH_PATH_SPACE FH_PATH_TYPE(float4)* hit) {
 #if FH_LANES == 8
   lfloat t_min, t_max;
   const lvec3 org = gather_xyzw(ray_org, p, &t_min), dir = gather_xyzw(ray_dir, p, &t_max);
@@ -41,7 +41,7 @@ FH_INLINE void intersect_camera_lanes(__global const Bvh8Node* nodes, __global c
   FH_EACH_LANE(l) {
     if (!LANE(active, l)) continue;
     const TraceHit one = {LANE(h.t, l), LANE(h.b1, l), LANE(h.b2, l), LANE(h.triangle, l)};
-    hit[LANE(p, l)] = stored_hit(one);
+    store_lane(hit, p, l, stored_hit(one));
   }
 #else
   intersect_lanes(nodes, blocks, p, active, ray_org, ray_dir, hit);

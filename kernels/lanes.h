@@ -121,8 +121,9 @@ FH_INLINE lvec3 v3_select(lmask m, lvec3 if_true, lvec3 if_false) {
 // ---- Gathers and scatters: per-path and per-triangle data by index ----
 
 // With FH_PRIVATE_PATHS (the CPU megakernel, megakernel.cl), the path state is each
-// work-item's own private arrays rather than global buffers, so the gathers and scatters
-// come in both address spaces (overloaded; the other programs keep plain functions).
+// work-item's own vectors rather than global buffers (lanes_of_float4 and the others
+// below), so the gathers and scatters come for both (overloaded; the other programs keep
+// plain functions).
 #if defined(FH_MEGAKERNEL) && FH_LANES > 1
 #define FH_PRIVATE_PATHS
 #define FH_ACCESS FH_INLINE __attribute__((overloadable))
@@ -216,16 +217,63 @@ FH_ACCESS lvec3 gather_xyzw(__global const float4* base, luint index, lfloat* w)
 FH_GATHERS(__global)
 #endif
 FH_SCATTERS(__global)
-#ifdef FH_PRIVATE_PATHS
-FH_GATHERS(__private)
-FH_SCATTERS(__private)
-#endif
 #undef FH_GATHERS
 #undef FH_SCATTERS
 #undef FH_FLOAT4_ACCESS
 #undef FH_GATHER_XYZW
 #undef FH_SCATTER
 #undef FH_GATHER
+
+// One path-state field of every lane in registers (FH_PRIVATE_PATHS): a float4 field as
+// four vectors, a scalar field as one. The megakernel's lanes index their own state by
+// their positions, so the accesses below take the index only to match the global ones:
+// a gather is the vectors themselves and a scatter a blend, where an array of float4 per
+// lane costs a transpose and a branch per lane.
+#ifdef FH_PRIVATE_PATHS
+typedef struct {
+  lfloat x, y, z, w;
+} lanes_of_float4;
+typedef lfloat lanes_of_float;
+typedef luint lanes_of_uint;
+typedef lint lanes_of_int;
+
+#define FH_LANES_ACCESS(element, lanes_type)                                                      \
+  FH_ACCESS lanes_type gather_##element(__private const lanes_type* base, luint index) { return *base; } \
+  FH_ACCESS void scatter_##element(__private lanes_type* base, luint index, lanes_type v, lmask m) { \
+    *base = select(*base, v, m);                                                                  \
+  }
+FH_LANES_ACCESS(float, lfloat)
+FH_LANES_ACCESS(uint, luint)
+FH_LANES_ACCESS(int, lint)
+#undef FH_LANES_ACCESS
+FH_ACCESS lvec3 gather_xyzw(__private const lanes_of_float4* base, luint index, lfloat* w) {
+  *w = base->w;
+  return v3(base->x, base->y, base->z);
+}
+FH_ACCESS lvec3 gather_xyz(__private const lanes_of_float4* base, luint index) { return v3(base->x, base->y, base->z); }
+FH_ACCESS lfloat gather_w(__private const lanes_of_float4* base, luint index) { return base->w; }
+FH_ACCESS void scatter_xyzw(__private lanes_of_float4* base, luint index, lvec3 v, lfloat w, lmask m) {
+  base->x = select(base->x, v.x, m);
+  base->y = select(base->y, v.y, m);
+  base->z = select(base->z, v.z, m);
+  base->w = select(base->w, w, m);
+}
+// Lane l's element (l need not be known at compile time), and that element plus v.
+FH_ACCESS void store_lane(__private lanes_of_float4* base, luint index, int l, float4 v) {
+  LANE(base->x, l) = v.x;
+  LANE(base->y, l) = v.y;
+  LANE(base->z, l) = v.z;
+  LANE(base->w, l) = v.w;
+}
+FH_ACCESS void add_to_lane(__private lanes_of_float4* base, luint index, int l, float4 v) {
+  LANE(base->x, l) += v.x;
+  LANE(base->y, l) += v.y;
+  LANE(base->z, l) += v.z;
+  LANE(base->w, l) += v.w;
+}
+#endif
+FH_ACCESS void store_lane(__global float4* base, luint index, int l, float4 v) { base[LANE(index, l)] = v; }
+FH_ACCESS void add_to_lane(__global float4* base, luint index, int l, float4 v) { base[LANE(index, l)] += v; }
 
 FH_INLINE lvec2 gather_xy(__global const float2* base, luint index) {
   lvec2 r;

@@ -16,7 +16,7 @@
 // state of its lanes in private arrays instead (below), and leaves the buffers alone.
 #define FH_PATH_BUFFER(type, name, bytes) , __global type* name##_buffer
 #define FH_PATH_BUFFERS FH_PATH_FIELDS(FH_PATH_BUFFER)
-#define FH_PATH_PRIVATE(type, name, bytes) type name[FH_LANES];
+#define FH_PATH_PRIVATE(type, name, bytes) FH_PATH_TYPE(type) name[1];  // an array: passed as a pointer
 #else
 #define FH_PATH_BUFFERS FH_PATH_PARAMS
 #endif
@@ -50,10 +50,10 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
   const lmask owns_slot = g < slots && g < count;
   if (lanes_any(owns_slot)) {
 #ifdef FH_PRIVATE_PATHS
-    // Lane l's path state is element l of the work-item's own arrays, next to its other
-    // private values, instead of a global slot's: the accesses need no addresses computed
-    // from slot indices, and most name their lane at compile time, so the compiler can keep
-    // those in registers.
+    // The lanes' path state is the work-item's own, each field one set of vectors
+    // (lanes.h), instead of global slots': no addresses computed from slot indices, no
+    // transposes between a lane's float4 and the lanes' vectors, and the compiler can keep
+    // the fields in registers.
     FH_PATH_FIELDS(FH_PATH_PRIVATE)
     const luint p = lane_positions(0);
 #else

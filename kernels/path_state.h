@@ -48,14 +48,16 @@
 #ifdef __OPENCL_VERSION__
 #include "ray.h"
 
-// Where the path state lives: global buffers, or with FH_PRIVATE_PATHS (lanes.h) the
-// megakernel's private arrays.
+// Where the path state lives: global buffers of `type` per slot, or with FH_PRIVATE_PATHS
+// (lanes.h) the megakernel's own variables, each one field of all its lanes.
 #ifdef FH_PRIVATE_PATHS
 #define FH_PATH_SPACE __private
+#define FH_PATH_TYPE(type) lanes_of_##type
 #else
 #define FH_PATH_SPACE __global
+#define FH_PATH_TYPE(type) type
 #endif
-#define FH_PATH_PARAM(type, name, bytes) , FH_PATH_SPACE type* name
+#define FH_PATH_PARAM(type, name, bytes) , FH_PATH_SPACE FH_PATH_TYPE(type)* name
 #define FH_PATH_ARG(type, name, bytes) , name
 // Appended to a kernel's or a stage function's parameter list:
 // `__kernel void k(int a FH_PATH_PARAMS)`, and to a call that passes them on: `f(a FH_PATH_ARGS)`.

@@ -144,7 +144,7 @@ FH_INLINE void connect_light(RenderParams params, const ShadowRequest* r, lmask 
     if (!LANE(connects, k)) continue;
     if (find_occluder_precomputed(nodes, blocks, lane_ray(&rays, k), 0.0f, LANE(ls.shadow_distance, k)) >= 0)
       continue;
-    radiance[LANE(p, k)] += (float4)(v3_lane(contribution, k), 0.0f);
+    add_to_lane(radiance, p, k, (float4)(v3_lane(contribution, k), 0.0f));
   }
 }
 
