@@ -21,6 +21,25 @@
 #define FH_PATH_BUFFERS FH_PATH_PARAMS
 #endif
 
+// Counts the finished lanes' samples in the work-group's books, per pass slot. The lanes
+// start their samples together, so those that finish together mostly belong to one pass:
+// then one atomic add counts them all.
+FH_INLINE void count_finished(volatile __local uint* finished_in_slot, luint slot, lmask finished) {
+  const luint low = select((luint)(UINT_MAX), slot, finished), high = select((luint)(0u), slot, finished);
+  uint lowest = UINT_MAX, highest = 0u;
+  FH_FOR_LANES(l) {
+    lowest = min(lowest, LANE(low, l));
+    highest = max(highest, LANE(high, l));
+  }
+  if (lowest == highest) {
+    atomic_add(&finished_in_slot[lowest], lanes_count(finished));
+    return;
+  }
+  FH_FOR_LANES(l) {
+    if (LANE(finished, l)) atomic_inc(&finished_in_slot[LANE(slot, l)]);
+  }
+}
+
 __kernel void megakernel(RenderParams params, volatile __global WavefrontCounters* counters, uint parity,
                          __global const uint* free_list, __global const float* filter_table,
                          __global const uint* pass_table, __global const uint* pixel_list,
@@ -87,9 +106,7 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
       if (lanes_any(o.finished)) {
         luint slot;
         const lmask finite = record_samples(p, o.finished, pass_buffer, &slot FH_PATH_ARGS);
-        FH_FOR_LANES(l) {
-          if (LANE(o.finished, l)) atomic_inc(&finished_in_slot[LANE(slot, l)]);
-        }
+        count_finished(finished_in_slot, slot, o.finished);
         nonfinite += lanes_count(o.finished && !finite);
       }
       alive = o.continues;
