@@ -66,6 +66,7 @@ FH_INLINE lfloat environment_weight(luint depth, lfloat bsdf_pdf, lfloat light_p
 typedef struct {
   lmask continues, light_sample, finished;
   ShadowRequest request;
+  PixelSampler sampler;  // the paths' samples, where light_sample is set (connect_light's too)
 } ShadeOutcome;
 
 // Shades path slots p where `active`: adds what the paths gathered at their hits to their
@@ -86,6 +87,7 @@ FH_INLINE ShadeOutcome shade_paths(RenderParams params, luint p, lmask active, _
   r->at.magnitude = (lfloat)(0.0f);
   r->material = (lint)(0);
   r->depth = (luint)(0);
+  o.sampler.pixel_seed = o.sampler.index_reversed = (luint)(0u);
   if (lanes_any(active)) {
     const lvec3 beta_in = gather_xyz(throughput, p);
     const luint bounce = gather_uint(depth, p);
@@ -165,6 +167,7 @@ FH_INLINE ShadeOutcome shade_paths(RenderParams params, luint p, lmask active, _
         const luint dim = bounce * FH_DIMS_PER_BOUNCE;
         const PixelSampler sampler =
             pixel_sampler(params.seed, gather_uint(sample_id, p), params.pixel_count, params.replicates);
+        o.sampler = sampler;
         const lvec2 u = sample_2d(&sampler, dim + FH_DIM_BSDF_U1);
         const BsdfSample b = bsdf_sample(&bsdf, s.normal, ns, wo, sample_1d(&sampler, dim + FH_DIM_BSDF_LOBE), u.x, u.y);
         lvec3 beta = v3_mul(beta_in, b.weight);

@@ -83,9 +83,10 @@ FH_INLINE LightSample select_light_sample(lmask m, LightSample a, LightSample b)
 }
 #endif
 
-// Connects the requests r where `active`: adds each unoccluded light sample's contribution
-// to its path's radiance.
-FH_INLINE void connect_light(RenderParams params, const ShadowRequest* r, lmask active, __global const Bvh8Node* nodes,
+// Connects the requests r where `active`, whose paths' samples are `sampler`: adds each
+// unoccluded light sample's contribution to its path's radiance.
+FH_INLINE void connect_light(RenderParams params, const ShadowRequest* r, const PixelSampler* sampler, lmask active,
+                             __global const Bvh8Node* nodes,
                              __global const TriangleBlock8* blocks, __global const float4* triangles,
                              __global const int* triangle_material, __global const GpuMaterial* materials,
                              __global const float* light_cdf, __global const int* light_triangle,
@@ -93,8 +94,6 @@ FH_INLINE void connect_light(RenderParams params, const ShadowRequest* r, lmask 
   const luint p = r->path;
   const SurfacePoint s = r->at;  // its normal: the geometric normal on the viewer's side
   const lvec3 n = r->shading_normal;  // same side
-  const PixelSampler sampler =
-      pixel_sampler(params.seed, gather_uint(sample_id, p), params.pixel_count, params.replicates);
   const luint dim = r->depth * FH_DIMS_PER_BOUNCE;
 
   // Connect from the point just off the surface that BSDF-sampled rays also start from:
@@ -103,8 +102,8 @@ FH_INLINE void connect_light(RenderParams params, const ShadowRequest* r, lmask 
   const lvec3 origin = offset_ray_origin(&s, s.normal);
   // The pick: the environment map below params.env_pick, a triangle by the light CDF
   // (whose entries start at env_pick) above.
-  const lfloat u_pick = sample_1d(&sampler, dim + FH_DIM_LIGHT_PICK);
-  const lvec2 u = sample_2d(&sampler, dim + FH_DIM_LIGHT_U1);
+  const lfloat u_pick = sample_1d(sampler, dim + FH_DIM_LIGHT_PICK);
+  const lvec2 u = sample_2d(sampler, dim + FH_DIM_LIGHT_U1);
   LightSample ls;
   ls.wi = ls.radiance = ls.shadow_direction = v3_splat(0.0f);
   ls.pdf = ls.shadow_distance = (lfloat)(0.0f);
@@ -159,7 +158,9 @@ __kernel void shadow_connect(RenderParams params, __global const WavefrontCounte
   const lmask active = position < counters->shadow_length;
   if (!lanes_any(active)) return;
   const ShadowRequest r = load_shadow_request(select((luint)(0), position, active) FH_SHADOW_ARGS);  // idle lanes read request 0
-  connect_light(params, &r, active, nodes, blocks, triangles, triangle_material, materials, light_cdf, light_triangle,
+  const PixelSampler sampler =
+      pixel_sampler(params.seed, gather_uint(sample_id, r.path), params.pixel_count, params.replicates);
+  connect_light(params, &r, &sampler, active, nodes, blocks, triangles, triangle_material, materials, light_cdf, light_triangle,
                 light_pdf_area, env_map FH_PATH_ARGS);
 }
 #endif
