@@ -14,14 +14,16 @@ FH_INLINE void intersect_slot(__global const Bvh8Node* nodes, __global const Tri
 // eight paths): intersect_slot for each, their rays set up together.
 FH_INLINE void intersect_lanes(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, luint p,
                                lmask active, FH_PATH_SPACE const FH_PATH_TYPE(float4)* ray_org,
-                               FH_PATH_SPACE const FH_PATH_TYPE(float4)* ray_dir, FH_PATH_SPACE FH_PATH_TYPE(float4)* hit) {
+                               FH_PATH_SPACE const FH_PATH_TYPE(float4)* ray_dir,
+                               FH_PATH_SPACE FH_PATH_TYPE(float4)* hit) {
   lfloat t_min, t_max;
   const lvec3 org = gather_xyzw(ray_org, p, &t_min), dir = gather_xyzw(ray_dir, p, &t_max);
   LaneRays rays;
   precompute_lane_rays(org, dir, &rays);
   FH_EACH_LANE(l) {
     if (LANE(active, l))
-      store_lane(hit, p, l, stored_hit(trace_precomputed(nodes, blocks, lane_ray(&rays, l), LANE(t_min, l), LANE(t_max, l))));
+      store_lane(hit, p, l,
+                 stored_hit(trace_precomputed(nodes, blocks, lane_ray(&rays, l), LANE(t_min, l), LANE(t_max, l))));
   }
 }
 

@@ -99,8 +99,8 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
       const ShadeOutcome o = shade_paths(params, p, alive, triangles, triangle_material, materials, light_pdf_area,
                                          normals, uvs, texels, texture_info, env_map, aovs FH_PATH_ARGS);
       if (lanes_any(o.light_sample))  // never for pt, nor without lights
-        connect_light(params, &o.request, &o.sampler, o.light_sample, nodes, blocks, triangles, triangle_material, materials,
-                      light_cdf, light_triangle, light_pdf_area, env_map FH_PATH_ARGS);
+        connect_light(params, &o.request, &o.sampler, o.light_sample, nodes, blocks, triangles, triangle_material,
+                      materials, light_cdf, light_triangle, light_pdf_area, env_map FH_PATH_ARGS);
       shadow_rays += lanes_count(o.light_sample);
       bounce_rays += lanes_count(o.continues);
       if (lanes_any(o.finished)) {

@@ -31,14 +31,8 @@ FH_LAYOUT(CameraParams, up, 48);
 FH_LAYOUT(CameraParams, width, 64);
 FH_LAYOUT(CameraParams, height, 68);
 
-static_assert(sizeof(GpuMaterial) == 80, "GpuMaterial");
-FH_LAYOUT(GpuMaterial, kd, 0);
-FH_LAYOUT(GpuMaterial, ke, 16);
-FH_LAYOUT(GpuMaterial, ks, 32);
-FH_LAYOUT(GpuMaterial, tf, 48);
-FH_LAYOUT(GpuMaterial, illum, 64);
-FH_LAYOUT(GpuMaterial, texture, 68);
-static_assert(sizeof(GpuMaterial) == 4 * FH_MATERIAL_WORDS, "GpuMaterial words");
+// Checked against the word offsets the kernels gather fields by (FH_MATERIAL_*, 4 bytes a word).
+static_assert(sizeof(GpuMaterial) == 80 && sizeof(GpuMaterial) == 4 * FH_MATERIAL_WORDS, "GpuMaterial");
 FH_LAYOUT(GpuMaterial, kd, 4 * FH_MATERIAL_KD);
 FH_LAYOUT(GpuMaterial, ke, 4 * FH_MATERIAL_KE);
 FH_LAYOUT(GpuMaterial, ks, 4 * FH_MATERIAL_KS);
