@@ -38,6 +38,20 @@ constexpr float kOverlapToTrySpatial = 1e-2f;
 // big tree: on the 1M-triangle scene, splits that won narrowly there left the whole
 // tree worse. Where spatial splits pay (long overlapping triangles), they win by far more.
 constexpr float kSpatialSplitGain = 0.05f;
+// Secondary rays start on the scene's surfaces, inside its boxes, and a ray visits every box
+// it starts in, which the area ratio alone does not count: a leaf whose box spans a room
+// (a floor, a back wall and a wall gathered in one block) is visited by nearly every ray in
+// the room, while the walls' flat boxes apart are visited only by the rays that reach them.
+// The wide tree's plan adds this weight times a box's share of the scene's volume to its
+// share of the area (ray origins taken as spread through the volume, in the spirit of
+// Fabianowski, Fowler and Dingliana, "A Cost Metric for Scene-Interior Ray Origins",
+// Eurographics 2009). Deep in a mesh, boxes are small and the term vanishes.
+constexpr float kVolumeWeight = 1.0f;
+// So that the plan may keep such primitives apart, the binary builder splits nodes holding
+// at least this share of the scene's volume down to leaves of kRoomyLeaf references
+// (the plan may gather them again); elsewhere its leaves take up to kMaxLeaf.
+constexpr float kRoomyVolume = 1e-2f;
+constexpr unsigned kRoomyLeaf = 2;
 
 // Grown with plain comparisons (std::min/max), which compile inline: fminf/fmaxf, which
 // must handle NaNs (scenes have none: the loader rejects them), were library calls on
@@ -58,6 +72,11 @@ struct Box {
     if (empty()) return 0.f;
     const float3 e = hi - lo;
     return 2.f * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]);
+  }
+  float volume() const {
+    if (empty()) return 0.f;
+    const float3 e = hi - lo;
+    return e[0] * e[1] * e[2];
   }
   float3 centroid() const { return (lo + hi) * 0.5f; }
   static Box overlap(const Box& a, const Box& b) {
@@ -163,8 +182,8 @@ constexpr unsigned kParallelTriangles = 16384;
 // budget, too, does not depend on the order subtrees are built in.
 class BinaryBuilder {
  public:
-  BinaryBuilder(const float3* corners, float rootArea, int parallelDepth)
-      : corners_(corners), rootArea_(rootArea), parallelDepth_(parallelDepth) {}
+  BinaryBuilder(const float3* corners, float rootArea, float rootVolume, int parallelDepth)
+      : corners_(corners), rootArea_(rootArea), rootVolume_(rootVolume), parallelDepth_(parallelDepth) {}
 
   BinaryTree build(References refs, size_t room, int depth = 0) {
     tree_.nodes.reserve(2 * refs.size());
@@ -339,7 +358,8 @@ class BinaryBuilder {
       const size_t added = spatial.leftCount + spatial.rightCount - count;
       if (spatial.cost < s.cost * (1.f - kSpatialSplitGain) && added <= room) s = spatial;
     }
-    if (s.axis >= 0 && count <= kMaxLeaf && kTriangleCost * float(count) <= s.cost) return makeLeaf(node, refs);
+    const unsigned mostInLeaf = box.volume() >= kRoomyVolume * rootVolume_ ? kRoomyLeaf : kMaxLeaf;
+    if (s.axis >= 0 && count <= mostInLeaf && kTriangleCost * float(count) <= s.cost) return makeLeaf(node, refs);
 
     // A spatial split's children own their references (this frame keeps them alive);
     // an object split's partition the node's in place.
@@ -382,7 +402,7 @@ class BinaryBuilder {
     if (depth < parallelDepth_ && right.size() >= kParallelTriangles) {
       // The two children own disjoint references: the right one on another thread.
       auto subtree = std::async(std::launch::async, [this, right, rightRoom, depth] {
-        return BinaryBuilder(corners_, rootArea_, parallelDepth_).build(right, rightRoom, depth + 1);
+        return BinaryBuilder(corners_, rootArea_, rootVolume_, parallelDepth_).build(right, rightRoom, depth + 1);
       });
       split(first, left, leftRoom, depth + 1);
       graft(first + 1, subtree.get());
@@ -412,6 +432,7 @@ class BinaryBuilder {
 
   const float3* corners_;
   float rootArea_;
+  float rootVolume_;  // INFINITY for a flat scene: no node is roomy
   int parallelDepth_;
   BinaryTree tree_;
 };
@@ -460,7 +481,7 @@ class WideCollapser {
 
   // The cheapest plans for one binary node's subtree.
   struct SlotPlan {
-    float cost[kWidth];  // cost[i - 1]: in at most i slots, relative to the root's area
+    float cost[kWidth];  // cost[i - 1]: in at most i slots, per ray (visitWeight)
     // leftSlots[i - 1] (i >= 2, inner nodes): how many of the i slots the left child's plan
     // gets; the right child's gets the rest.
     unsigned char leftSlots[kWidth];
@@ -468,14 +489,14 @@ class WideCollapser {
     unsigned references;  // in the subtree's leaves
   };
 
-  float leafCost(float area, unsigned references) const {
-    return references <= kMaxLeaf ? area * kLeafBlockCost : INFINITY;
+  float leafCost(float weight, unsigned references) const {
+    return references <= kMaxLeaf ? weight * kLeafBlockCost : INFINITY;
   }
 
   // Children before parents would need the builder's numbering; an explicit post-order
   // does not.
   void planSubtrees() {
-    const float rootArea = std::max(binary_[0].box.area(), 1e-30f);
+    const float rootArea = std::max(binary_[0].box.area(), 1e-30f), rootVolume = binary_[0].box.volume();
     std::vector<std::pair<int, bool>> stack = {{0, false}};
     while (!stack.empty()) {
       const auto [b, childrenDone] = stack.back();
@@ -487,16 +508,22 @@ class WideCollapser {
         stack.push_back({n.right, false});
         continue;
       }
-      planNode(b, n.box.area() / rootArea);
+      planNode(b, visitWeight(n.box, rootArea, rootVolume));
     }
   }
 
-  void planNode(int b, float area) {
+  // A box's chance of being visited, relative to the root's (see kVolumeWeight).
+  static float visitWeight(const Box& box, float rootArea, float rootVolume) {
+    const float volume = rootVolume > 0.f ? kVolumeWeight * box.volume() / rootVolume : 0.f;
+    return box.area() / rootArea + volume;
+  }
+
+  void planNode(int b, float weight) {
     const BinaryNode& n = binary_[size_t(b)];
     SlotPlan& p = plan_[size_t(b)];
     if (n.count > 0) {
       p.references = n.count;
-      std::fill(p.cost, p.cost + kWidth, leafCost(area, n.count));
+      std::fill(p.cost, p.cost + kWidth, leafCost(weight, n.count));
       std::fill(p.leftSlots, p.leftSlots + kWidth, 0);
       p.asLeaf = true;
       return;
@@ -518,8 +545,8 @@ class WideCollapser {
       p.cost[i - 1] = best;
       p.leftSlots[i - 1] = (unsigned char)bestLeft;
     }
-    const float leaf = leafCost(area, p.references);
-    const float wide = area * kTraversalCost + p.cost[kWidth - 1];
+    const float leaf = leafCost(weight, p.references);
+    const float wide = weight * kTraversalCost + p.cost[kWidth - 1];
     p.asLeaf = leaf <= wide;
     p.cost[0] = std::min(leaf, wide);
   }
@@ -651,7 +678,8 @@ Bvh buildBvh(const Scene& scene, BvhOptions options) {
   int parallelDepth = 0;
   while (threads > 1 && (1u << parallelDepth) < 4 * threads) ++parallelDepth;
   const size_t room = size_t(double(options.spatialSplitBudget) * double(refs.size()));
-  BinaryBuilder builder(corners.data(), std::max(sceneBox.area(), 1e-30f), parallelDepth);
+  const float sceneVolume = sceneBox.volume() > 0.f ? sceneBox.volume() : INFINITY;
+  BinaryBuilder builder(corners.data(), std::max(sceneBox.area(), 1e-30f), sceneVolume, parallelDepth);
   const BinaryTree binary = builder.build({refs.data(), refs.data() + refs.size()}, room);
   bvh.stats.binaryNodes = binary.nodes.size();
   bvh.stats.references = binary.leafTriangles.size();

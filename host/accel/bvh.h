@@ -18,7 +18,7 @@ struct BvhStats {
   double sahCost = 0.0;  // of the binary tree (bvh.cpp: sahCost), in box tests per ray
   // Of the 8-wide tree the kernels traverse, as its collapse plans it: 1 per wide node
   // visited and 1.2 per leaf block tested (eight triangles at 0.15), each weighted by its
-  // box's area over the root's.
+  // box's area over the root's plus its volume over the root's (bvh.cpp: kVolumeWeight).
   double wideSahCost = 0.0;
   double buildSeconds = 0.0;
 };
