@@ -38,7 +38,9 @@ FH_INLINE void start_sample(RenderParams params, PassShape older, PassShape newe
   scatter_xyzw(throughput, slot, v3_splat(1.0f), (lfloat)(0.0f), active);
   scatter_float(ray_pdf, slot, (lfloat)(0.0f), active);
   scatter_xyzw(radiance, slot, v3_splat(0.0f), (lfloat)(0.0f), active);
-  scatter_uint(sample_id, slot, k, active);
+  // Kept, not recomputed at every bounce from the sample's index (divisions and hashes).
+  scatter_uint(pixel_seed, slot, sampler.pixel_seed, active);
+  scatter_uint(point_reversed, slot, sampler.index_reversed, active);
   scatter_uint(pass_entry, slot, FH_PASS_ENTRY(j % entries, pass_slot), active);
   scatter_uint(depth, slot, (luint)(0), active);
 }

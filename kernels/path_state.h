@@ -14,7 +14,8 @@
   X(float4, throughput, 16)     /* rgb (w unused: 16-byte loads) */                              \
   X(float, ray_pdf, 4)          /* pdf with which the BSDF sampled ray_dir (MIS); < 0: delta */ \
   X(float4, radiance, 16)       /* rgb gathered so far */                                        \
-  X(uint, sample_id, 4)         /* global sample index: pixel = id % pixels, its point = id / pixels */ \
+  X(uint, pixel_seed, 4)        /* the sample's pixel sampler (sampler.h): its scrambling seed, */ \
+  X(uint, point_reversed, 4)    /* and its point in the pixel's sequence, bits reversed */       \
   X(uint, pass_entry, 4)        /* entry in the pass buffers and pass slot: FH_PASS_ENTRY */     \
   X(uint, depth, 4)             /* bounces so far */
 
@@ -47,6 +48,7 @@
 
 #ifdef __OPENCL_VERSION__
 #include "ray.h"
+#include "sampler.h"
 
 // Where the path state lives: global buffers of `type` per slot, or with FH_PRIVATE_PATHS
 // (lanes.h) the megakernel's own variables, each one field of all its lanes.
@@ -66,6 +68,14 @@
 #define FH_SHADOW_PARAM(type, name, bytes) , __global type* name
 #define FH_SHADOW_PARAMS FH_SHADOW_FIELDS(FH_SHADOW_PARAM)
 #define FH_SHADOW_ARGS FH_SHADOW_FIELDS(FH_PATH_ARG)
+
+// The pixel sampler of the paths in slots p, as start_sample kept it.
+FH_INLINE PixelSampler path_sampler(luint p FH_PATH_PARAMS) {
+  PixelSampler s;
+  s.pixel_seed = gather_uint(pixel_seed, p);
+  s.index_reversed = gather_uint(point_reversed, p);
+  return s;
+}
 
 // One light-sample request per lane, as shade makes it and shadow_connect uses it; the
 // wavefront stores it in the FH_SHADOW_FIELDS buffers between the two, the megakernel

@@ -165,8 +165,7 @@ FH_INLINE ShadeOutcome shade_paths(RenderParams params, luint p, lmask active, _
 
       if (lanes_any(may_bounce)) {
         const luint dim = bounce * FH_DIMS_PER_BOUNCE;
-        const PixelSampler sampler =
-            pixel_sampler(params.seed, gather_uint(sample_id, p), params.pixel_count, params.replicates);
+        const PixelSampler sampler = path_sampler(p FH_PATH_ARGS);
         o.sampler = sampler;
         const lvec2 u = sample_2d(&sampler, dim + FH_DIM_BSDF_U1);
         const BsdfSample b = bsdf_sample(&bsdf, s.normal, ns, wo, sample_1d(&sampler, dim + FH_DIM_BSDF_LOBE), u.x, u.y);

@@ -158,8 +158,7 @@ __kernel void shadow_connect(RenderParams params, __global const WavefrontCounte
   const lmask active = position < counters->shadow_length;
   if (!lanes_any(active)) return;
   const ShadowRequest r = load_shadow_request(select((luint)(0), position, active) FH_SHADOW_ARGS);  // idle lanes read request 0
-  const PixelSampler sampler =
-      pixel_sampler(params.seed, gather_uint(sample_id, r.path), params.pixel_count, params.replicates);
+  const PixelSampler sampler = path_sampler(r.path FH_PATH_ARGS);
   connect_light(params, &r, &sampler, active, nodes, blocks, triangles, triangle_material, materials, light_cdf,
                 light_triangle, light_pdf_area, env_map FH_PATH_ARGS);
 }
