@@ -337,20 +337,42 @@ FH_INLINE float4 stored_hit(TraceHit h) {
   return (float4)(h.triangle < 0 ? INFINITY : h.t, h.b1, h.b2, as_float(h.triangle));
 }
 
+// One step of a sorting network on eight keys: lane i meets lane partner[i] and keeps the
+// smaller of the two where keep_min[i] is set, the larger elsewhere.
+FH_INLINE int8 sort_step(int8 keys, uint8 partner, int8 keep_min) {
+  const int8 other = shuffle(keys, partner);
+  return select(max(keys, other), min(keys, other), keep_min);
+}
+
+// Eight keys in ascending order: Batcher's bitonic network, six steps of whole-vector
+// operations, where an insertion sort would branch on every comparison.
+FH_INLINE int8 sort8(int8 k) {
+  const uint8 pairs = (uint8)(1, 0, 3, 2, 5, 4, 7, 6), twos = (uint8)(2, 3, 0, 1, 6, 7, 4, 5);
+  // Blocks of two, then four, sorted alternately up and down (bitonic), then merged up.
+  k = sort_step(k, pairs, (int8)(-1, 0, 0, -1, -1, 0, 0, -1));
+  k = sort_step(k, twos, (int8)(-1, -1, 0, 0, 0, 0, -1, -1));
+  k = sort_step(k, pairs, (int8)(-1, 0, -1, 0, 0, -1, 0, -1));
+  k = sort_step(k, (uint8)(4, 5, 6, 7, 0, 1, 2, 3), (int8)(-1, -1, -1, -1, 0, 0, 0, 0));
+  k = sort_step(k, twos, (int8)(-1, -1, 0, 0, -1, -1, 0, 0));
+  return sort_step(k, pairs, (int8)(-1, 0, -1, 0, -1, 0, -1, 0));
+}
+
 // Visits the children the ray hits nearest first: returns the nearest (0 if none) and
-// pushes the others, farthest first, with their distances; among equal distances the
-// higher lane counts as nearer. One or two children hit, the common cases, take no loop.
+// pushes the others, farthest first, with their distances. One or two children hit, the
+// common cases, take no sort. The order never changes the hit found (closer_hit8), only
+// how soon the farther boxes are culled. The stack needs eight entries of room past its
+// deepest use (vstore8).
 FH_INLINE int order_children(float8 t_near, __global const Bvh8Node* node, int* stack_node, float* stack_t,
                              int* sp) {
-  uint hits = lane_bits(t_near != (float8)(INFINITY));
+  const uint hits = lane_bits(t_near != (float8)(INFINITY));
   if (hits == 0) return 0;
-  float t[8];
-  vstore8(t_near, 0, t);
   const int first = lowest_bit(hits);
-  hits &= hits - 1;
-  if (hits == 0) return node->child[first];
-  if ((hits & (hits - 1)) == 0) {
-    const int second = lowest_bit(hits);
+  const uint rest = hits & (hits - 1);
+  if (rest == 0) return node->child[first];
+  if ((rest & (rest - 1)) == 0) {
+    float t[8];
+    vstore8(t_near, 0, t);
+    const int second = lowest_bit(rest);
     const bool swap = t[first] < t[second];
     const int far = swap ? second : first, near = swap ? first : second;
     stack_node[*sp] = node->child[far];
@@ -358,25 +380,19 @@ FH_INLINE int order_children(float8 t_near, __global const Bvh8Node* node, int* 
     ++*sp;
     return node->child[near];
   }
-  int order[8];
-  int n = 1;
-  order[0] = first;
-  for (; hits; hits &= hits - 1) {
-    const int i = lowest_bit(hits);
-    // Insertion sort by decreasing distance.
-    int j = n++;
-    while (j > 0 && t[order[j - 1]] < t[i]) {
-      order[j] = order[j - 1];
-      --j;
-    }
-    order[j] = i;
-  }
-  for (int k = 0; k < n - 1; ++k) {
-    stack_node[*sp] = node->child[order[k]];
-    stack_t[*sp] = t[order[k]];
-    ++*sp;
-  }
-  return node->child[order[n - 1]];
+  // Three or more: sorted as integer keys, a distance's bits with its lane in the low three
+  // (non-negative floats order as their bits; misses, +INFINITY, sort last). The stack
+  // takes the exact distances, so the truncated bits only reorder near-ties.
+  const int8 lanes = (int8)(0, 1, 2, 3, 4, 5, 6, 7);
+  const int8 order = sort8((as_int8(t_near) & (int8)(~7)) | lanes) & (int8)(7);  // nearest first
+  const int n = (int)popcount(hits);
+  // Stack entry *sp + k takes the (n - 1 - k)-th nearest, k < n - 1 (the lanes past them are
+  // overwritten by later pushes).
+  const uint8 pushed = as_uint8(shuffle(order, as_uint8((int8)(n - 1) - lanes)));
+  vstore8(shuffle(vload8(0, node->child), pushed), 0, stack_node + *sp);
+  vstore8(shuffle(t_near, pushed), 0, stack_t + *sp);
+  *sp += n - 1;
+  return node->child[order.s0];
 }
 
 // The closest hit in [t_min, t_max) of the ray r was precomputed from.
@@ -386,8 +402,8 @@ FH_INLINE TraceHit trace_precomputed(__global const Bvh8Node* nodes, __global co
   hit.t = t_max;
   hit.b1 = hit.b2 = 0.0f;
   hit.triangle = -1;
-  int stack_node[FH_TRAVERSAL_STACK];
-  float stack_t[FH_TRAVERSAL_STACK];
+  int stack_node[FH_TRAVERSAL_STACK + 8];
+  float stack_t[FH_TRAVERSAL_STACK + 8];
   int sp = 0;
   int ref = 0;  // the root
   for (;;) {
