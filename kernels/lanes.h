@@ -102,6 +102,22 @@ FH_INLINE lvec3 v3_abs(lvec3 a) { return v3(fabs(a.x), fabs(a.y), fabs(a.z)); }
 FH_INLINE lvec3 v3_max(lvec3 a, lvec3 b) { return v3(fmax(a.x, b.x), fmax(a.y, b.y), fmax(a.z, b.z)); }
 FH_INLINE lvec3 v3_clamp01(lvec3 a) { return v3(clamp(a.x, 0.0f, 1.0f), clamp(a.y, 0.0f, 1.0f), clamp(a.z, 0.0f, 1.0f)); }
 FH_INLINE lfloat v3_max_component(lvec3 a) { return fmax(fmax(a.x, a.y), a.z); }
+// Bit l set where m sets lane l, and the mask of the lanes whose bits are set.
+FH_INLINE uint lanes_bits(lmask m) {
+#if FH_LANES == 1
+  return m ? 1u : 0u;
+#else
+  return lane_bits(m);
+#endif
+}
+FH_INLINE lmask lanes_of_bits(uint bits) {
+#if FH_LANES == 1
+  return (bits & 1u) != 0u;
+#else
+  return ((uint8)(bits) & (uint8)(1, 2, 4, 8, 16, 32, 64, 128)) != (uint8)(0u);
+#endif
+}
+
 // A mask of every lane (true) or none.
 FH_INLINE lmask lanes_mask(bool all) { return (lint)(all ? 1 : 0) != 0; }
 // Lanes where any component is positive.
@@ -258,22 +274,18 @@ FH_ACCESS void scatter_xyzw(__private lanes_of_float4* base, luint index, lvec3 
   base->z = select(base->z, v.z, m);
   base->w = select(base->w, w, m);
 }
-// Lane l's element (l need not be known at compile time), and that element plus v.
-FH_ACCESS void store_lane(__private lanes_of_float4* base, luint index, int l, float4 v) {
-  LANE(base->x, l) = v.x;
-  LANE(base->y, l) = v.y;
-  LANE(base->z, l) = v.z;
-  LANE(base->w, l) = v.w;
-}
-FH_ACCESS void add_to_lane(__private lanes_of_float4* base, luint index, int l, float4 v) {
-  LANE(base->x, l) += v.x;
-  LANE(base->y, l) += v.y;
-  LANE(base->z, l) += v.z;
-  LANE(base->w, l) += v.w;
+// base[index].xyz += v where m is set.
+FH_ACCESS void add_xyz(__private lanes_of_float4* base, luint index, lvec3 v, lmask m) {
+  base->x = select(base->x, base->x + v.x, m);
+  base->y = select(base->y, base->y + v.y, m);
+  base->z = select(base->z, base->z + v.z, m);
 }
 #endif
-FH_ACCESS void store_lane(__global float4* base, luint index, int l, float4 v) { base[LANE(index, l)] = v; }
-FH_ACCESS void add_to_lane(__global float4* base, luint index, int l, float4 v) { base[LANE(index, l)] += v; }
+FH_ACCESS void add_xyz(__global float4* base, luint index, lvec3 v, lmask m) {
+  FH_FOR_LANES(l) {
+    if (LANE(m, l)) base[LANE(index, l)].xyz += (float3)(LANE(v.x, l), LANE(v.y, l), LANE(v.z, l));
+  }
+}
 
 FH_INLINE lvec2 gather_xy(__global const float2* base, luint index) {
   lvec2 r;

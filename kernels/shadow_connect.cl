@@ -139,12 +139,15 @@ FH_INLINE void connect_light(RenderParams params, const ShadowRequest* r, const 
 
   LaneRays rays;
   precompute_lane_rays(origin, ls.shadow_direction, &rays);
-  FH_EACH_LANE(k) {
-    if (!LANE(connects, k)) continue;
-    if (find_occluder_precomputed(nodes, blocks, lane_ray(&rays, k), 0.0f, LANE(ls.shadow_distance, k)) >= 0)
-      continue;
-    add_to_lane(radiance, p, k, (float4)(v3_lane(contribution, k), 0.0f));
+  // The lanes' shadow rays one by one, only those that connect; the unoccluded ones add
+  // their contributions together at the end.
+  uint unoccluded = 0u;
+  for (uint left = lanes_bits(connects); left != 0u; left &= left - 1u) {
+    const int k = lowest_bit(left);
+    if (find_occluder_precomputed(nodes, blocks, lane_ray(&rays, k), 0.0f, LANE(ls.shadow_distance, k)) < 0)
+      unoccluded |= 1u << k;
   }
+  add_xyz(radiance, p, contribution, lanes_of_bits(unoccluded));
 }
 
 #if !defined(FH_MEGAKERNEL)  // the megakernel calls the stage function itself
