@@ -1,0 +1,113 @@
+#!/usr/bin/python3
+"""Where a PoCL kernel's time goes, by source function: a `perf record` of one fredholm run,
+its samples attributed to the kernel's inlined functions.
+
+  bench/kernel_profile.py [--fredholm build/fredholm] [--kernel megakernel] [--top 30]
+                          -- render SCENE ARGS...
+
+The kernels are built with `-g` (FREDHOLM_CL_OPTIONS) into a fresh PoCL cache. PoCL runs a
+work-group function it generates around the kernel (`_pocl_kernel_K_workgroup`) that has no
+line table of its own, while the kernel function it was made from (`_pocl_kernel_K`) has
+one; the two bodies are nearly the same instructions, so the work-group function's are
+matched to the kernel's (difflib over opcodes and operands, addresses masked), and each
+sample takes the inlining chain llvm-symbolizer gives for its matched address. Prints the
+share of the kernel's samples per stage function (what the kernel calls), per innermost
+function and per call chain. Needs perf (Debian linux-perf), llvm-symbolizer (llvm) and
+objdump (binutils).
+"""
+import argparse, bisect, collections, difflib, glob, os, re, subprocess, sys, tempfile
+
+
+def functions(disassembly):
+    """{name: [(address, opcode, operands)]} from objdump -d."""
+    out, current = {}, None
+    for line in disassembly.splitlines():
+        m = re.match(r"^([0-9a-f]+) <(.*)>:", line)
+        if m:
+            current = out.setdefault(m.group(2), [])
+            continue
+        m = re.match(r"^\s+([0-9a-f]+):\s+(\S+)\s*(.*)$", line)
+        if m and current is not None:
+            current.append((int(m.group(1), 16), m.group(2), m.group(3)))
+    return out
+
+
+def shape(instruction):
+    operands = re.sub(r"<[^>]*>", "", re.sub(r"0x[0-9a-f]+", "N", instruction[2]))
+    return instruction[1] + " " + operands
+
+
+def main():
+    argv = sys.argv[1:]
+    split = argv.index("--") if "--" in argv else len(argv)
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--fredholm", default=os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                                       "build", "fredholm"))
+    ap.add_argument("--kernel", default="megakernel")
+    ap.add_argument("--top", type=int, default=30)
+    args = ap.parse_args(argv[:split])
+    command = argv[split + 1:]
+    if not command:
+        ap.error("give the fredholm command after --, e.g. -- render scene.obj --spp 64")
+
+    work = tempfile.mkdtemp(prefix="fh_profile_")
+    cache, data = os.path.join(work, "cache"), os.path.join(work, "perf.data")
+    env = dict(os.environ, FREDHOLM_CL_OPTIONS=(os.environ.get("FREDHOLM_CL_OPTIONS", "") + " -g").strip(),
+               POCL_CACHE_DIR=cache)
+    subprocess.run(["perf", "record", "-q", "-o", data, "--", args.fredholm] + command + ["-o",
+                   os.path.join(work, "image.pfm"), "--force"], env=env, check=True,
+                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+    kernel, workgroup = "_pocl_kernel_" + args.kernel, "_pocl_kernel_" + args.kernel + "_workgroup"
+    samples = subprocess.run(["perf", "script", "-i", data, "-F", "ip,sym,symoff,dso"], capture_output=True,
+                             text=True).stdout
+    hits = collections.Counter()  # (shared object, offset in the work-group function) -> samples
+    for line in samples.splitlines():
+        m = re.match(r"\s*[0-9a-f]+\s+" + re.escape(workgroup) + r"\+0x([0-9a-f]+)\s+\((.*)\)", line)
+        if m:
+            hits[(m.group(2), int(m.group(1), 16))] += 1
+    if not hits:
+        sys.exit(f"kernel_profile: no samples in {workgroup} (is the kernel's name right?)")
+    library = collections.Counter(so for so, _ in hits.elements()).most_common(1)[0][0]
+
+    bodies = functions(subprocess.run(["objdump", "-d", "--no-show-raw-insn", library], capture_output=True,
+                                      text=True).stdout)
+    source, target = bodies[kernel], bodies[workgroup]
+    matcher = difflib.SequenceMatcher(None, [shape(i) for i in source], [shape(i) for i in target], autojunk=False)
+    to_source = {}
+    for a, b, n in matcher.get_matching_blocks():
+        for k in range(n):
+            to_source[target[b + k][0] - target[0][0]] = source[a + k][0]
+    matched = sorted(to_source)
+
+    by_address = collections.Counter()
+    for (so, offset), count in hits.items():
+        if so != library:
+            continue
+        i = bisect.bisect_right(matched, offset) - 1  # an unmatched instruction goes with the one before it
+        if i >= 0:
+            by_address[to_source[matched[i]]] += count
+    addresses = sorted(by_address)
+    symbolized = subprocess.run(["llvm-symbolizer", "--inlining", "--obj=" + library],
+                                input="\n".join(hex(a) for a in addresses), capture_output=True,
+                                text=True).stdout.strip().split("\n\n")
+
+    total = sum(by_address.values())
+    stage, inner, chain = collections.Counter(), collections.Counter(), collections.Counter()
+    for address, frames in zip(addresses, symbolized):
+        names = frames.strip().split("\n")[0::2]
+        count = by_address[address]
+        inner[names[0]] += count
+        stage[names[-2] if len(names) >= 2 else names[-1]] += count
+        chain[" < ".join(names[:4])] += count
+    print(f"{args.kernel}: {total} samples in {os.path.relpath(library, cache)}, "
+          f"{len(to_source)} of {len(target)} instructions matched to the kernel's line table")
+    for title, counter in (("stage (called by the kernel)", stage), ("innermost function", inner),
+                           ("call chain", chain)):
+        print(f"\n{title}:")
+        for name, count in counter.most_common(args.top):
+            print(f"  {100.0 * count / total:5.1f}%  {name}")
+
+
+if __name__ == "__main__":
+    main()
