@@ -54,10 +54,6 @@ typedef int8 lmask;
 // insert or extract) rather than an element of a vector in memory.
 #define FH_FOR_LANES(l) _Pragma("unroll") for (int l = 0; l < FH_LANES; ++l)
 
-// A loop over the lanes that stays a loop, for bodies as large as a ray traversal: eight
-// unrolled copies of those would not fit the instruction cache.
-#define FH_EACH_LANE(l) _Pragma("unroll 1") for (int l = 0; l < FH_LANES; ++l)
-
 // ---- Two- and three-component vectors of lanes ----
 
 typedef struct {
