@@ -18,9 +18,16 @@
 #define FH_TRAVERSAL_STACK 64
 #endif
 
-// Lane l of x, where `picked` is set in lane l only: exact for every value, -0 and NaN
-// included (bits are masked, not added).
-FH_INLINE float lane_value(float8 x, int8 picked) { return as_float(or_lanes(as_int8(x) & picked)); }
+// Lane l of x (0 <= l < 8), exact for every value, -0 and NaN included. On x86 one
+// permute; elsewhere the other lanes' bits are masked off and the lanes OR-ed together.
+FH_INLINE float lane_at(float8 x, int l) {
+#ifdef __AVX2__
+  typedef int fh_v8si __attribute__((vector_size(32)));
+  return __builtin_ia32_permvarsf256((fh_v8sf)x, (fh_v8si)(int8)(l))[0];
+#else
+  return as_float(or_lanes(as_int8(x) & ((int8)(l) == (int8)(0, 1, 2, 3, 4, 5, 6, 7))));
+#endif
+}
 
 // Minimum and maximum by comparisons, which compile to single min/max instructions (fmin
 // and fmax must also handle NaNs, which the distances they serve never are: ray
@@ -269,24 +276,26 @@ FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8
     if (!any_lane(valid)) return -1;
   }
   if (any_hit) return lowest_bit(lane_bits(valid));
-  const float8 t = select((float8)(INFINITY), quotient, valid);
-  // The nearest lane; among equals (rare again), the lowest index.
-  const float nearest = min_lane(t);
-  const int8 at_nearest = valid & (t == (float8)(nearest));
-  uint lanes = lane_bits(at_nearest);
+  uint lanes = lane_bits(valid);
+  // Mostly one lane hits; with more, the nearest, and among equals (rare again) the lowest index.
   if (lanes & (lanes - 1)) {
-    const int8 id_at = select((int8)(INT_MAX), ids, at_nearest);
-    const int4 i4 = min(id_at.lo, id_at.hi);
-    const int2 i2 = min(i4.lo, i4.hi);
-    lanes = lane_bits(at_nearest & (ids == (int8)(min(i2.x, i2.y))));
+    const float8 t = select((float8)(INFINITY), quotient, valid);
+    const int8 at_nearest = valid & (t == (float8)(min_lane(t)));
+    lanes = lane_bits(at_nearest);
+    if (lanes & (lanes - 1)) {
+      const int8 id_at = select((int8)(INT_MAX), ids, at_nearest);
+      const int4 i4 = min(id_at.lo, id_at.hi);
+      const int2 i2 = min(i4.lo, i4.hi);
+      lanes = lane_bits(at_nearest & (ids == (int8)(min(i2.x, i2.y))));
+    }
   }
   const int lowest = lowest_bit(lanes);
-  *t_max = nearest;
-  // Divided in all lanes at once and picked out in registers (a store and reload per value
-  // stalled here); the unpicked lanes' quotients, infinite or not, are dropped.
-  const int8 picked = (int8)(lowest) == (int8)(0, 1, 2, 3, 4, 5, 6, 7);
-  *b1 = lane_value(e.v / e.det, picked);
-  *b2 = lane_value(e.w / e.det, picked);
+  *t_max = lane_at(quotient, lowest);
+  // The hit lane's quotients alone, as the lane of a vector division would give them (the
+  // same bits: a division is correctly rounded either way).
+  const float det = lane_at(e.det, lowest);
+  *b1 = lane_at(e.v, lowest) / det;
+  *b2 = lane_at(e.w, lowest) / det;
   return lowest;
 }
 
@@ -370,13 +379,12 @@ FH_INLINE int order_children(float8 t_near, __global const Bvh8Node* node, int* 
   const uint rest = hits & (hits - 1);
   if (rest == 0) return node->child[first];
   if ((rest & (rest - 1)) == 0) {
-    float t[8];
-    vstore8(t_near, 0, t);
     const int second = lowest_bit(rest);
-    const bool swap = t[first] < t[second];
+    const float t_first = lane_at(t_near, first), t_second = lane_at(t_near, second);
+    const bool swap = t_first < t_second;
     const int far = swap ? second : first, near = swap ? first : second;
     stack_node[*sp] = node->child[far];
-    stack_t[*sp] = t[far];
+    stack_t[*sp] = swap ? t_second : t_first;
     ++*sp;
     return node->child[near];
   }
