@@ -3,7 +3,7 @@
 its samples attributed to the kernel's inlined functions.
 
   bench/kernel_profile.py [--fredholm build/fredholm] [--kernel megakernel] [--top 30]
-                          -- render SCENE ARGS...
+                          -- render SCENE ARGS...   (or: -- bench SCENE ARGS...)
 
 The kernels are built with `-g` (FREDHOLM_CL_OPTIONS) into a fresh PoCL cache. PoCL runs a
 work-group function it generates around the kernel (`_pocl_kernel_K_workgroup`) that has no
@@ -54,8 +54,9 @@ def main():
     cache, data = os.path.join(work, "cache"), os.path.join(work, "perf.data")
     env = dict(os.environ, FREDHOLM_CL_OPTIONS=(os.environ.get("FREDHOLM_CL_OPTIONS", "") + " -g").strip(),
                POCL_CACHE_DIR=cache)
-    subprocess.run(["perf", "record", "-q", "-o", data, "--", args.fredholm] + command + ["-o",
-                   os.path.join(work, "image.pfm"), "--force"], env=env, check=True,
+    # A render's image goes to the scratch folder; other commands (bench) write none.
+    image = ["-o", os.path.join(work, "image.pfm"), "--force"] if command[0] == "render" else []
+    subprocess.run(["perf", "record", "-q", "-o", data, "--", args.fredholm] + command + image, env=env, check=True,
                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
     kernel, workgroup = "_pocl_kernel_" + args.kernel, "_pocl_kernel_" + args.kernel + "_workgroup"
