@@ -5,7 +5,7 @@ its samples attributed to the kernel's inlined functions.
   bench/kernel_profile.py [--fredholm build/fredholm] [--kernel megakernel] [--top 30]
                           -- render SCENE ARGS...   (or: -- bench SCENE ARGS...)
 
-The kernels are built with `-g` (FREDHOLM_CL_OPTIONS) into a fresh PoCL cache. PoCL runs a
+The kernels are built from source with `-g` (FREDHOLM_CL_OPTIONS) into fresh caches. PoCL runs a
 work-group function it generates around the kernel (`_pocl_kernel_K_workgroup`) that has no
 line table of its own, while the kernel function it was made from (`_pocl_kernel_K`) has
 one; the two bodies are nearly the same instructions, so the work-group function's are
@@ -52,8 +52,10 @@ def main():
 
     work = tempfile.mkdtemp(prefix="fh_profile_")
     cache, data = os.path.join(work, "cache"), os.path.join(work, "perf.data")
+    # Both caches fresh: a program loaded from fredholm's binary cache is compiled by PoCL
+    # without the line table that -g gives a build from source.
     env = dict(os.environ, FREDHOLM_CL_OPTIONS=(os.environ.get("FREDHOLM_CL_OPTIONS", "") + " -g").strip(),
-               POCL_CACHE_DIR=cache)
+               POCL_CACHE_DIR=cache, FREDHOLM_CACHE_DIR=os.path.join(work, "programs"))
     # A render's image goes to the scratch folder; other commands (bench) write none.
     image = ["-o", os.path.join(work, "image.pfm"), "--force"] if command[0] == "render" else []
     subprocess.run(["perf", "record", "-q", "-o", data, "--", args.fredholm] + command + image, env=env, check=True,
