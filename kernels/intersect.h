@@ -22,7 +22,6 @@
 // permute; elsewhere the other lanes' bits are masked off and the lanes OR-ed together.
 FH_INLINE float lane_at(float8 x, int l) {
 #ifdef __AVX2__
-  typedef int fh_v8si __attribute__((vector_size(32)));
   return __builtin_ia32_permvarsf256((fh_v8sf)x, (fh_v8si)(int8)(l))[0];
 #else
   return as_float(or_lanes(as_int8(x) & ((int8)(l) == (int8)(0, 1, 2, 3, 4, 5, 6, 7))));

@@ -203,16 +203,14 @@ FH_INLINE lvec3 v3_select(lmask m, lvec3 if_true, lvec3 if_false) {
 // a flat address, which OpenCL C has no cast to; a CPU device has one address space, so the
 // global pointer goes through an integer. Its word offsets are signed 32-bit: buffers up
 // to 8 GiB, which every buffer a CPU device is given here stays under.
-typedef float fh_gather_v8sf __attribute__((vector_size(32)));
-typedef int fh_gather_v8si __attribute__((vector_size(32)));
 FH_INLINE float8 gather_words(__global const void* base, int8 word) {
-  const fh_gather_v8sf all = (fh_gather_v8sf)as_float8((int8)(-1));
+  const fh_v8sf all = (fh_v8sf)as_float8((int8)(-1));
   union {
-    fh_gather_v8sf x86;
+    fh_v8sf x86;
     float8 lanes;
   } r;
-  r.x86 = __builtin_ia32_gatherd_ps256((fh_gather_v8sf)(float8)(0.0f), (const void*)(ulong)base,
-                                       (fh_gather_v8si)word, all, 4);
+  r.x86 = __builtin_ia32_gatherd_ps256((fh_v8sf)(float8)(0.0f), (const void*)(ulong)base,
+                                       (fh_v8si)word, all, 4);
   return r.lanes;
 }
 FH_ACCESS lfloat gather_float(__global const float* base, luint index) { return gather_words(base, as_int8(index)); }

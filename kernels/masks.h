@@ -12,7 +12,10 @@ FH_INLINE int or_lanes(int8 x) {
 }
 
 #ifdef __AVX__
+// Clang's x86 vector types, which the x86 built-ins take (OpenCL's float8 and int8 convert
+// to them by a cast of the same bits).
 typedef float fh_v8sf __attribute__((vector_size(32)));
+typedef int fh_v8si __attribute__((vector_size(32)));
 #endif
 
 // Bit i set where lane i of `lanes` has its sign bit set (as any() and all() read masks).
