@@ -49,8 +49,13 @@ def main():
     command = argv[split + 1:]
     if not command:
         ap.error("give the fredholm command after --, e.g. -- render scene.obj --spp 64")
+    # The scratch folder (perf's record, the caches, the image) goes when the report is out.
+    with tempfile.TemporaryDirectory(prefix="fh_profile_") as work:
+        profile(args, command, work)
 
-    work = tempfile.mkdtemp(prefix="fh_profile_")
+
+def profile(args, command, work):
+    """Records `fredholm COMMAND` in the folder `work` and prints the kernel's samples by source function."""
     cache, data = os.path.join(work, "cache"), os.path.join(work, "perf.data")
     # Both caches fresh: a program loaded from fredholm's binary cache is compiled by PoCL
     # without the line table that -g gives a build from source.
