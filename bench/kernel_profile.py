@@ -12,7 +12,7 @@ one; the two bodies are nearly the same instructions, so the work-group function
 matched to the kernel's (difflib over opcodes and operands, addresses masked), and each
 sample takes the inlining chain llvm-symbolizer gives for its matched address. Prints the
 share of the kernel's samples per stage function (what the kernel calls), per innermost
-function and per call chain. Needs perf (Debian linux-perf), llvm-symbolizer (llvm) and
+function, per call chain and per source line. Needs perf (Debian linux-perf), llvm-symbolizer (llvm) and
 objdump (binutils).
 """
 import argparse, bisect, collections, difflib, glob, os, re, subprocess, sys, tempfile
@@ -101,17 +101,20 @@ def profile(args, command, work):
                                 text=True).stdout.strip().split("\n\n")
 
     total = sum(by_address.values())
-    stage, inner, chain = collections.Counter(), collections.Counter(), collections.Counter()
+    stage, inner, chain, lines = (collections.Counter() for _ in range(4))
     for address, frames in zip(addresses, symbolized):
-        names = frames.strip().split("\n")[0::2]
+        entries = frames.strip().split("\n")
+        names = entries[0::2]
         count = by_address[address]
         inner[names[0]] += count
+        if len(entries) > 1:  # file:line:column of the innermost frame, column dropped
+            lines[f"{names[0]} {os.path.basename(entries[1].rsplit(':', 1)[0])}"] += count
         stage[names[-2] if len(names) >= 2 else names[-1]] += count
         chain[" < ".join(names[:4])] += count
     print(f"{args.kernel}: {total} samples in {os.path.relpath(library, cache)}, "
           f"{len(to_source)} of {len(target)} instructions matched to the kernel's line table")
     for title, counter in (("stage (called by the kernel)", stage), ("innermost function", inner),
-                           ("call chain", chain)):
+                           ("call chain", chain), ("source line", lines)):
         print(f"\n{title}:")
         for name, count in counter.most_common(args.top):
             print(f"  {100.0 * count / total:5.1f}%  {name}")
