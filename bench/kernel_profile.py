@@ -12,8 +12,8 @@ one; the two bodies are nearly the same instructions, so the work-group function
 matched to the kernel's (difflib over opcodes and operands, addresses masked), and each
 sample takes the inlining chain llvm-symbolizer gives for its matched address. Prints the
 share of the kernel's samples per stage function (what the kernel calls), per innermost
-function, per call chain and per source line. Needs perf (Debian linux-perf), llvm-symbolizer (llvm) and
-objdump (binutils).
+function, per call chain and per source line. Needs perf (Debian linux-perf),
+llvm-symbolizer (llvm) and objdump (binutils).
 """
 import argparse, bisect, collections, difflib, glob, os, re, subprocess, sys, tempfile
 
@@ -55,7 +55,8 @@ def main():
 
 
 def profile(args, command, work):
-    """Records `fredholm COMMAND` in the folder `work` and prints the kernel's samples by source function."""
+    """Records `fredholm COMMAND` in the folder `work` and prints the kernel's samples by stage, innermost
+    function, call chain and source line."""
     cache, data = os.path.join(work, "cache"), os.path.join(work, "perf.data")
     # Both caches fresh: a program loaded from fredholm's binary cache is compiled by PoCL
     # without the line table that -g gives a build from source.
