@@ -12,8 +12,9 @@ one; the two bodies are nearly the same instructions, so the work-group function
 matched to the kernel's (difflib over opcodes and operands, addresses masked), and each
 sample takes the inlining chain llvm-symbolizer gives for its matched address. Prints the
 share of the kernel's samples per stage function (what the kernel calls), per innermost
-function, per call chain and per source line. Needs perf (Debian linux-perf),
-llvm-symbolizer (llvm) and objdump (binutils).
+function, per call chain, per source line and per innermost loop of the machine code (with
+the lines most sampled in it). Needs perf (Debian linux-perf), llvm-symbolizer (llvm) and
+objdump (binutils).
 """
 import argparse, bisect, collections, difflib, glob, os, re, subprocess, sys, tempfile
 
@@ -56,7 +57,7 @@ def main():
 
 def profile(args, command, work):
     """Records `fredholm COMMAND` in the folder `work` and prints the kernel's samples by stage, innermost
-    function, call chain and source line."""
+    function, call chain, source line and innermost loop."""
     cache, data = os.path.join(work, "cache"), os.path.join(work, "perf.data")
     # Both caches fresh: a program loaded from fredholm's binary cache is compiled by PoCL
     # without the line table that -g gives a build from source.
@@ -103,13 +104,16 @@ def profile(args, command, work):
 
     total = sum(by_address.values())
     stage, inner, chain, lines = (collections.Counter() for _ in range(4))
+    line_of = {}  # source address -> its innermost frame's function and file:line
     for address, frames in zip(addresses, symbolized):
         entries = frames.strip().split("\n")
         names = entries[0::2]
         count = by_address[address]
         inner[names[0]] += count
+        line_of[address] = names[0]
         if len(entries) > 1:  # file:line:column of the innermost frame, column dropped
-            lines[f"{names[0]} {os.path.basename(entries[1].rsplit(':', 1)[0])}"] += count
+            line_of[address] = f"{names[0]} {os.path.basename(entries[1].rsplit(':', 1)[0])}"
+            lines[line_of[address]] += count
         stage[names[-2] if len(names) >= 2 else names[-1]] += count
         chain[" < ".join(names[:4])] += count
     print(f"{args.kernel}: {total} samples in {os.path.relpath(library, cache)}, "
@@ -119,6 +123,45 @@ def profile(args, command, work):
         print(f"\n{title}:")
         for name, count in counter.most_common(args.top):
             print(f"  {100.0 * count / total:5.1f}%  {name}")
+    print_loops(target, hits, library, matched, to_source, line_of, args.top)
+
+
+def loops_of(body):
+    """The loops of a disassembled function as (first, last) offsets from its start: a backward
+    jump's target heads a loop that runs to the last jump back to it."""
+    start, last = body[0][0], {}
+    for address, opcode, operands in body:
+        m = re.match(r"([0-9a-f]+)\b", operands)
+        if opcode.startswith("j") and m and start <= int(m.group(1), 16) <= address:
+            last[int(m.group(1), 16) - start] = address - start
+    return sorted(last.items())
+
+
+def print_loops(target, hits, library, matched, to_source, line_of, top):
+    """Samples by the innermost loop of the work-group function they fall in, with the source
+    lines most sampled in each. Compiler-made instructions (spills, address arithmetic, the
+    mask moves around a comparison) carry no line or a neighbour's, so a loop's whole share
+    says more about what a stretch of code costs than the per-line table does."""
+    loops = loops_of(target)
+    share, inside = collections.Counter(), collections.defaultdict(collections.Counter)
+    for (so, offset), count in hits.items():
+        if so != library:
+            continue
+        around = [lp for lp in loops if lp[0] <= offset <= lp[1]]
+        loop = min(around, key=lambda lp: lp[1] - lp[0]) if around else None
+        share[loop] += count
+        i = bisect.bisect_right(matched, offset) - 1
+        if i >= 0 and loop:
+            inside[loop][line_of.get(to_source[matched[i]], "?")] += count
+    sizes = {lp: sum(1 for a, _, _ in target if lp[0] <= a - target[0][0] <= lp[1]) for lp in share if lp}
+    total = sum(share.values())
+    print("\ninnermost loop (offsets in the work-group function; its three most sampled lines):")
+    for loop, count in share.most_common(top):
+        if loop is None:
+            print(f"  {100.0 * count / total:5.1f}%  outside every loop")
+            continue
+        hot = ", ".join(f"{name} {100.0 * c / count:.0f}%" for name, c in inside[loop].most_common(3))
+        print(f"  {100.0 * count / total:5.1f}%  {loop[0]:#x}-{loop[1]:#x} ({sizes[loop]} instructions): {hot}")
 
 
 if __name__ == "__main__":
