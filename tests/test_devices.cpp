@@ -1,5 +1,8 @@
 // Device listing and the --device grammar, on PoCL; the CLI's messages and exit codes.
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <sstream>
 
 #include "device/devices.h"
 #include "test_support.h"
@@ -69,6 +72,54 @@ TEST(DevicesCli, NoOpenClPlatformIsAClearError) {
   const auto r = test::runFredholm("devices", "OCL_ICD_VENDORS=" + dir);
   EXPECT_EQ(r.exitCode, 1);
   EXPECT_NE(r.output.find("fredholm: error: no OpenCL platform found"), std::string::npos) << r.output;
+}
+
+TEST(Devices, CpuWorkersArePinnedOnlyWhereThatKeepsThemOnTheAllowedCpus) {
+  EXPECT_TRUE(cpuWorkersMayBePinned({0, 1}, 2));
+  EXPECT_TRUE(cpuWorkersMayBePinned({1, 0}, 2));
+  EXPECT_TRUE(cpuWorkersMayBePinned({0, 1, 2, 3}, 4));
+  EXPECT_FALSE(cpuWorkersMayBePinned({0}, 2));     // taskset -c 0 on two CPUs
+  EXPECT_FALSE(cpuWorkersMayBePinned({2, 3}, 4));  // a container's cpuset without CPU 0
+  EXPECT_FALSE(cpuWorkersMayBePinned({0, 2}, 2));  // a gap in the numbering
+  EXPECT_FALSE(cpuWorkersMayBePinned({1}, 1));
+  EXPECT_FALSE(cpuWorkersMayBePinned({}, 0));
+}
+
+// Each thread's allowed CPUs (Cpus_allowed_list), a line per thread, of a render started with
+// `prefix` in front of it, once PoCL's workers are up; the render is then stopped.
+std::vector<std::string> renderThreadCpus(const std::string& prefix) {
+  const std::string dir = test::tempDir("affinity");
+  test::writeFile(dir + "/run.sh",
+                  prefix + " env POCL_DEVICES=pthread " + FREDHOLM_BINARY +
+                      " render --width 64 --height 64 --spp 1000000 -o " + dir + "/a.pfm >/dev/null 2>&1 &\n"
+                      "pid=$!\n"
+                      "for i in $(seq 300); do [ $(ls /proc/$pid/task | wc -l) -ge 3 ] && break; sleep 0.1; done\n"
+                      "sleep 1\n"
+                      "for t in /proc/$pid/task/*; do sed -n 's/^Cpus_allowed_list:[[:space:]]*//p' $t/status; done\n"
+                      "kill $pid\n"
+                      "wait $pid\n");
+  const auto r = test::runCommand("sh " + dir + "/run.sh");
+  std::vector<std::string> lines;
+  std::istringstream in(r.output);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) lines.push_back(line);
+  return lines;
+}
+
+TEST(DevicesCli, RenderKeepsEveryThreadOnTheCpusItWasGiven) {
+  // Pinning PoCL's workers to CPUs 0..n-1 would move one onto CPU 1 here.
+  const auto cpus = renderThreadCpus("taskset -c 0");
+  ASSERT_GE(cpus.size(), 3u) << "the render's threads were not found";
+  for (const std::string& c : cpus) EXPECT_EQ(c, "0");
+}
+
+TEST(DevicesCli, RenderPinsPoclWorkersWhereItMayUseEveryCpu) {
+  const long online = sysconf(_SC_NPROCESSORS_ONLN);
+  const auto cpus = renderThreadCpus("");
+  ASSERT_GE(cpus.size(), 3u) << "the render's threads were not found";
+  // Worker i runs on CPU i alone; the other threads keep the whole machine.
+  for (long cpu = 0; cpu < online; ++cpu)
+    EXPECT_NE(std::find(cpus.begin(), cpus.end(), std::to_string(cpu)), cpus.end()) << "no thread pinned to " << cpu;
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include "bench/bench.h"
 #include "cli/commands.h"
+#include "device/devices.h"
 #include "device/program.h"
 #ifdef FREDHOLM_HAVE_EMBREE
 #include "embree_tracer.h"
@@ -166,6 +167,7 @@ CLI::App* addExport(CLI::App& app, ExportOptions& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  pinCpuWorkersWhereSafe();
   CLI::App app{"fredholm: an OpenCL wavefront path tracer"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "fredholm " FREDHOLM_VERSION);

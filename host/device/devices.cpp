@@ -1,8 +1,12 @@
 // Device enumeration and selection for --device.
 #include "device/devices.h"
 
+#include <sched.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
 #include <iomanip>
 #include <set>
 #include <sstream>
@@ -50,6 +54,26 @@ std::string describeAvailable(const std::vector<DeviceInfo>& all) {
 }
 
 }  // namespace
+
+bool cpuWorkersMayBePinned(const std::vector<int>& allowedCpus, long onlineCpus) {
+  if (onlineCpus <= 0 || long(allowedCpus.size()) != onlineCpus) return false;
+  std::vector<int> sorted = allowedCpus;
+  std::sort(sorted.begin(), sorted.end());
+  for (size_t i = 0; i < sorted.size(); ++i)
+    if (sorted[i] != int(i)) return false;
+  return true;
+}
+
+void pinCpuWorkersWhereSafe() {
+  for (const char* tuned : {"POCL_AFFINITY", "POCL_MAX_PTHREAD_COUNT", "POCL_CPU_MAX_CU_COUNT"})
+    if (std::getenv(tuned)) return;
+  cpu_set_t mask;
+  if (sched_getaffinity(0, sizeof mask, &mask) != 0) return;
+  std::vector<int> allowed;
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu)
+    if (CPU_ISSET(cpu, &mask)) allowed.push_back(cpu);
+  if (cpuWorkersMayBePinned(allowed, sysconf(_SC_NPROCESSORS_ONLN))) setenv("POCL_AFFINITY", "1", 0);
+}
 
 std::vector<DeviceInfo> listDevices() {
   std::vector<cl::Platform> platforms;

@@ -33,4 +33,17 @@ std::vector<DeviceInfo> selectDevices(const std::vector<DeviceInfo>& all, const 
 // The table `fredholm devices` prints.
 std::string formatDeviceTable(const std::vector<DeviceInfo>& devices);
 
+// Whether PoCL's CPU driver may pin worker i to CPU i (POCL_AFFINITY=1) and keep every worker
+// inside the CPUs this process may run on: only where those are all the machine's online
+// CPUs, numbered 0 to n - 1. Elsewhere (taskset, mpirun --bind-to, a container's cpuset)
+// pinning would move workers onto CPUs the user kept it off.
+bool cpuWorkersMayBePinned(const std::vector<int>& allowedCpus, long onlineCpus);
+
+// Sets POCL_AFFINITY=1 where cpuWorkersMayBePinned allows it and the user has tuned none of
+// PoCL's CPU threads (POCL_AFFINITY, POCL_MAX_PTHREAD_COUNT, POCL_CPU_MAX_CU_COUNT unset).
+// Unpinned, the OS may leave two workers on one core for a while after the cores were busy
+// with other threads, which slows a kernel by tens of percent at random (bench/RESULTS.md).
+// Call before the first OpenCL call and before any other thread starts.
+void pinCpuWorkersWhereSafe();
+
 }  // namespace fh
