@@ -152,8 +152,8 @@ class SceneBench {
     // A repeat traces the rays t.passes times with each tracer (set after the warm-up): enough
     // that the scheduler's hiccups (milliseconds) are small against it on scenes that trace
     // in a few. Each tracer's turn starts with a pass that is not timed: the first pass after
-    // a switch runs while the other's thread pool may still spin on the cores (Embree's
-    // workers do, after a trace) or its own is asleep, which says nothing of either tracer.
+    // a switch finds the caches full of the other's data and the threads placed for the
+    // other's, which says nothing of either tracer (bench/RESULTS.md).
     auto traceExternal = [&] {
       for (size_t a = 0; a < apis.size(); ++a) {
         auto once = [&] {
