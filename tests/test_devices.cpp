@@ -1,6 +1,5 @@
 // Device listing and the --device grammar, on PoCL; the CLI's messages and exit codes.
 #include <gtest/gtest.h>
-#include <sched.h>
 #include <unistd.h>
 
 #include <sstream>
@@ -86,16 +85,6 @@ TEST(Devices, CpuWorkersArePinnedOnlyWhereThatKeepsThemOnTheAllowedCpus) {
   EXPECT_FALSE(cpuWorkersMayBePinned({}, 0));
 }
 
-// The CPUs this process may run on.
-std::vector<int> allowedCpus() {
-  cpu_set_t mask;
-  EXPECT_EQ(sched_getaffinity(0, sizeof mask, &mask), 0);
-  std::vector<int> cpus;
-  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu)
-    if (CPU_ISSET(cpu, &mask)) cpus.push_back(cpu);
-  return cpus;
-}
-
 // Each thread's allowed CPUs (Cpus_allowed_list), a line per thread, of a render started with
 // `prefix` in front of it, once PoCL's workers are up (a second thread, then a second more);
 // the render is then stopped.
@@ -120,7 +109,9 @@ std::vector<std::string> renderThreadCpus(const std::string& prefix) {
 
 TEST(DevicesCli, RenderKeepsEveryThreadOnTheCpusItWasGiven) {
   // Pinning PoCL's workers to CPUs 0..n-1 would move all but one off this CPU.
-  const std::string cpu = std::to_string(allowedCpus().front());
+  const std::vector<int> allowed = allowedCpus();
+  ASSERT_FALSE(allowed.empty()) << "this process's CPU mask could not be read";
+  const std::string cpu = std::to_string(allowed.front());
   const auto cpus = renderThreadCpus("taskset -c " + cpu);
   ASSERT_GE(cpus.size(), 2u) << "the render's threads were not found";
   for (const std::string& c : cpus) EXPECT_EQ(c, cpu);
@@ -128,6 +119,7 @@ TEST(DevicesCli, RenderKeepsEveryThreadOnTheCpusItWasGiven) {
 
 TEST(DevicesCli, RenderPinsPoclWorkersWhereItMayUseEveryCpu) {
   const std::vector<int> allowed = allowedCpus();
+  ASSERT_FALSE(allowed.empty()) << "this process's CPU mask could not be read";
   const auto cpus = renderThreadCpus("");
   ASSERT_GE(cpus.size(), 2u) << "the render's threads were not found";
   if (cpuWorkersMayBePinned(allowed, sysconf(_SC_NPROCESSORS_ONLN))) {

@@ -64,15 +64,19 @@ bool cpuWorkersMayBePinned(const std::vector<int>& allowedCpus, long onlineCpus)
   return true;
 }
 
+std::vector<int> allowedCpus() {
+  cpu_set_t mask;
+  std::vector<int> cpus;
+  if (sched_getaffinity(0, sizeof mask, &mask) != 0) return cpus;
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu)
+    if (CPU_ISSET(cpu, &mask)) cpus.push_back(cpu);
+  return cpus;
+}
+
 void pinCpuWorkersWhereSafe() {
   for (const char* tuned : {"POCL_AFFINITY", "POCL_MAX_PTHREAD_COUNT", "POCL_CPU_MAX_CU_COUNT"})
     if (std::getenv(tuned)) return;
-  cpu_set_t mask;
-  if (sched_getaffinity(0, sizeof mask, &mask) != 0) return;
-  std::vector<int> allowed;
-  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu)
-    if (CPU_ISSET(cpu, &mask)) allowed.push_back(cpu);
-  if (cpuWorkersMayBePinned(allowed, sysconf(_SC_NPROCESSORS_ONLN))) setenv("POCL_AFFINITY", "1", 0);
+  if (cpuWorkersMayBePinned(allowedCpus(), sysconf(_SC_NPROCESSORS_ONLN))) setenv("POCL_AFFINITY", "1", 0);
 }
 
 std::vector<DeviceInfo> listDevices() {

@@ -33,6 +33,10 @@ std::vector<DeviceInfo> selectDevices(const std::vector<DeviceInfo>& all, const 
 // The table `fredholm devices` prints.
 std::string formatDeviceTable(const std::vector<DeviceInfo>& devices);
 
+// The CPUs this process may run on (its affinity mask), in increasing order; empty if the
+// mask cannot be read.
+std::vector<int> allowedCpus();
+
 // Whether PoCL's CPU driver may pin worker i to CPU i (POCL_AFFINITY=1) and keep every worker
 // inside the CPUs this process may run on: only where those are all the machine's online
 // CPUs, numbered 0 to n - 1. Elsewhere (taskset, mpirun --bind-to, a container's cpuset)
