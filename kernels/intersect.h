@@ -54,16 +54,40 @@ FH_INLINE int lowest_bit(uint m) { return 31 - (int)clz(m & (0u - m)); }
 typedef struct {
   float3 inv_dir;
   // Per axis, which of a node's two planes the ray enters by (its offset in floats in
-  // Bvh8Node: the low plane where the direction is positive) and the origin as that plane
-  // meets it; the exit plane is the other (offset ^ 8; kernel_layouts.cpp pins the
-  // offsets). Chosen once per ray, so a box test needs no min and max to sort each axis'
-  // two distances.
+  // Bvh8Node: the low plane where the direction is positive); the exit plane is the other
+  // (offset ^ 8; kernel_layouts.cpp pins the offsets). Chosen once per ray, so a box test
+  // needs no min and max to sort each axis' two distances.
   int near_x, near_y, near_z;
-  float3 org_near, org_far;  // the origin as the slab test meets the entry and exit planes
+  // The distance to an entry plane is plane * inv_dir + near_offset, to an exit plane
+  // plane * inv_dir + far_offset (FH_NEAR_OFFSET).
+  float3 near_offset, far_offset;
   int kx, ky, kz;
   float sx, sy, sz;
   float ox, oy, oz;  // origin components along kx, ky, kz
 } RayPrecomp;
+
+// The slab test's distance to a plane p along an axis is p * inv + offset, one fused
+// multiply-add (p * inv is exact inside it), with offset = -(o * inv), the origin's part.
+// That product is rounded, by up to half an ulp, and a rounding of it could move a box's
+// entry later or its exit earlier by far more than the distance's own ulp (an origin far
+// from the world's, near the box); so the entry's offset is moved down and the exit's up by
+// FH_ULP_STEP, and the distances can only widen the slab. The distance itself is then
+// rounded once, which FH_SLAB_WIDEN covers. Macros, for float3 and float8 alike (the same
+// bits).
+//
+// o * inv, clamped to the finite floats (infinity moved by a step could be NaN; the clamped
+// value still errs the right way once stepped).
+#define FH_ORIGIN_TERM(o, inv, type) clamp((o) * (inv), (type)(-FLT_MAX), (type)(FLT_MAX))
+// At least one ulp of x, for every finite x (checked against nextafter on every binade's
+// edges and 20 million random floats), and at most two where x is at least 2^-103: x's
+// magnitude scaled by 2^-23 is exact, and the rounded sum cannot fall below it. Never below
+// the smallest normal float: an origin at 0 would give a denormal offset, and a
+// multiply-add with a denormal operand takes a microcode assist on x86.
+#define FH_ULP_STEP(x, type) fma(fabs(x), (type)(0x1p-23f), (type)(FLT_MIN))
+#define FH_NEAR_OFFSET(o, inv, type) \
+  (-(FH_ORIGIN_TERM(o, inv, type) + FH_ULP_STEP(FH_ORIGIN_TERM(o, inv, type), type)))
+#define FH_FAR_OFFSET(o, inv, type) \
+  (-(FH_ORIGIN_TERM(o, inv, type) - FH_ULP_STEP(FH_ORIGIN_TERM(o, inv, type), type)))
 
 FH_INLINE float component(float3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
 
@@ -100,8 +124,8 @@ FH_INLINE RayPrecomp precompute_ray(float3 org, float3 dir) {
   r.near_x = forward.x ? 0 : 8;
   r.near_y = forward.y ? 16 : 24;
   r.near_z = forward.z ? 32 : 40;
-  r.org_near = select(org_hi, org_lo, forward);
-  r.org_far = select(org_lo, org_hi, forward);
+  r.near_offset = FH_NEAR_OFFSET(select(org_hi, org_lo, forward), r.inv_dir, float3);
+  r.far_offset = FH_FAR_OFFSET(select(org_lo, org_hi, forward), r.inv_dir, float3);
   return r;
 }
 
@@ -111,7 +135,7 @@ FH_INLINE RayPrecomp precompute_ray(float3 org, float3 dir) {
 typedef struct {
   float inv_x[8], inv_y[8], inv_z[8];
   int near_x[8], near_y[8], near_z[8];
-  float org_near_x[8], org_near_y[8], org_near_z[8], org_far_x[8], org_far_y[8], org_far_z[8];
+  float near_offset_x[8], near_offset_y[8], near_offset_z[8], far_offset_x[8], far_offset_y[8], far_offset_z[8];
   int kx[8], ky[8], kz[8];
   float sx[8], sy[8], sz[8];
   float ox[8], oy[8], oz[8];
@@ -168,12 +192,12 @@ FH_INLINE void precompute_rays8(float8 ox, float8 oy, float8 oz, float8 dx, floa
   vstore8(select((int8)(8), zero, fwd_x), 0, r->near_x);
   vstore8(select((int8)(24), (int8)(16), fwd_y), 0, r->near_y);
   vstore8(select((int8)(40), (int8)(32), fwd_z), 0, r->near_z);
-  vstore8(select(hi_x, lo_x, fwd_x), 0, r->org_near_x);
-  vstore8(select(hi_y, lo_y, fwd_y), 0, r->org_near_y);
-  vstore8(select(hi_z, lo_z, fwd_z), 0, r->org_near_z);
-  vstore8(select(lo_x, hi_x, fwd_x), 0, r->org_far_x);
-  vstore8(select(lo_y, hi_y, fwd_y), 0, r->org_far_y);
-  vstore8(select(lo_z, hi_z, fwd_z), 0, r->org_far_z);
+  vstore8(FH_NEAR_OFFSET(select(hi_x, lo_x, fwd_x), inv_x, float8), 0, r->near_offset_x);
+  vstore8(FH_NEAR_OFFSET(select(hi_y, lo_y, fwd_y), inv_y, float8), 0, r->near_offset_y);
+  vstore8(FH_NEAR_OFFSET(select(hi_z, lo_z, fwd_z), inv_z, float8), 0, r->near_offset_z);
+  vstore8(FH_FAR_OFFSET(select(lo_x, hi_x, fwd_x), inv_x, float8), 0, r->far_offset_x);
+  vstore8(FH_FAR_OFFSET(select(lo_y, hi_y, fwd_y), inv_y, float8), 0, r->far_offset_y);
+  vstore8(FH_FAR_OFFSET(select(lo_z, hi_z, fwd_z), inv_z, float8), 0, r->far_offset_z);
 }
 
 // Ray l's constants from precompute_rays8.
@@ -183,8 +207,8 @@ FH_INLINE RayPrecomp ray_of_lane(const RayPrecomp8* s, int l) {
   r.near_x = s->near_x[l];
   r.near_y = s->near_y[l];
   r.near_z = s->near_z[l];
-  r.org_near = (float3)(s->org_near_x[l], s->org_near_y[l], s->org_near_z[l]);
-  r.org_far = (float3)(s->org_far_x[l], s->org_far_y[l], s->org_far_z[l]);
+  r.near_offset = (float3)(s->near_offset_x[l], s->near_offset_y[l], s->near_offset_z[l]);
+  r.far_offset = (float3)(s->far_offset_x[l], s->far_offset_y[l], s->far_offset_z[l]);
   r.kx = s->kx[l];
   r.ky = s->ky[l];
   r.kz = s->kz[l];
@@ -324,12 +348,12 @@ FH_INLINE float8 slab_near(float8 tx0, float8 tx1, float8 ty0, float8 ty1, float
 FH_INLINE float8 intersect_children(const RayPrecomp* r, __global const Bvh8Node* node, float t_max) {
   __global const float* planes = (__global const float*)node;
   const float8 ix = (float8)(r->inv_dir.x), iy = (float8)(r->inv_dir.y), iz = (float8)(r->inv_dir.z);
-  const float8 nx = (vload8(0, planes + r->near_x) - (float8)(r->org_near.x)) * ix;
-  const float8 fx = (vload8(0, planes + (r->near_x ^ 8)) - (float8)(r->org_far.x)) * ix;
-  const float8 ny = (vload8(0, planes + r->near_y) - (float8)(r->org_near.y)) * iy;
-  const float8 fy = (vload8(0, planes + (r->near_y ^ 8)) - (float8)(r->org_far.y)) * iy;
-  const float8 nz = (vload8(0, planes + r->near_z) - (float8)(r->org_near.z)) * iz;
-  const float8 fz = (vload8(0, planes + (r->near_z ^ 8)) - (float8)(r->org_far.z)) * iz;
+  const float8 nx = fma(vload8(0, planes + r->near_x), ix, (float8)(r->near_offset.x));
+  const float8 fx = fma(vload8(0, planes + (r->near_x ^ 8)), ix, (float8)(r->far_offset.x));
+  const float8 ny = fma(vload8(0, planes + r->near_y), iy, (float8)(r->near_offset.y));
+  const float8 fy = fma(vload8(0, planes + (r->near_y ^ 8)), iy, (float8)(r->far_offset.y));
+  const float8 nz = fma(vload8(0, planes + r->near_z), iz, (float8)(r->near_offset.z));
+  const float8 fz = fma(vload8(0, planes + (r->near_z ^ 8)), iz, (float8)(r->far_offset.z));
   const int8 empty = vload8(0, node->child) == (int8)(0);
   return select(slab_entry(nx, ny, nz, fx, fy, fz, (float8)(t_max)), (float8)(INFINITY), empty);
 }

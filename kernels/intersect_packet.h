@@ -18,7 +18,7 @@
 // scalars, so a triangle's components load once for all lanes, and otherwise each lane
 // picks its own three (packets of incoherent rays, on small trees).
 typedef struct {
-  float8 org_lo_x, org_lo_y, org_lo_z, org_hi_x, org_hi_y, org_hi_z;
+  float8 lo_offset_x, lo_offset_y, lo_offset_z, hi_offset_x, hi_offset_y, hi_offset_z;  // FH_NEAR_OFFSET, per plane
   float8 inv_x, inv_y, inv_z;
   float8 sx, sy, sz, ox, oy, oz;
   float8 t_min;
@@ -27,14 +27,19 @@ typedef struct {
   bool uniform;
 } RayPacket;
 
-// Slab-test constants of one axis for all lanes, as precompute_ray makes them.
-FH_INLINE void slab_lanes(float8 o, float8 d, float8* org_lo, float8* org_hi, float8* inv) {
+// Slab-test constants of one axis for all lanes, as precompute_ray makes them: the low
+// plane is a lane's entry plane where its direction is positive, its exit plane elsewhere.
+FH_INLINE void slab_lanes(float8 o, float8 d, float8* lo_offset, float8* hi_offset, float8* inv) {
   const float8 tiny = (float8)(1e-30f);
   const int8 flat = fabs(d) < tiny;
   const float8 eps = fmax(fabs(o), (float8)(1.0f)) * 0x1p-20f;
   *inv = 1.0f / select(d, tiny, flat);
-  *org_lo = select(o, o + eps, flat);
-  *org_hi = select(o, o - eps, flat);
+  const float8 org_lo = select(o, o + eps, flat), org_hi = select(o, o - eps, flat);
+  // FH_NEAR_OFFSET and FH_FAR_OFFSET (the same bits: -(a + b) is -a - b), the step's sign
+  // picked by the direction's instead of a select between the two.
+  const float8 lo = FH_ORIGIN_TERM(org_lo, *inv, float8), hi = FH_ORIGIN_TERM(org_hi, *inv, float8);
+  *lo_offset = -lo - copysign(FH_ULP_STEP(lo, float8), *inv);
+  *hi_offset = -hi + copysign(FH_ULP_STEP(hi, float8), *inv);
 }
 
 // precompute_ray for ray l in lane l, all lanes at once (the same operations, so the same
@@ -57,9 +62,9 @@ FH_INLINE void make_packet_lanes(float8 ox, float8 oy, float8 oz, float8 dx, flo
   p->ox = component8(ox, oy, oz, kx);
   p->oy = component8(ox, oy, oz, ky);
   p->oz = component8(ox, oy, oz, kz);
-  slab_lanes(ox, dx, &p->org_lo_x, &p->org_hi_x, &p->inv_x);
-  slab_lanes(oy, dy, &p->org_lo_y, &p->org_hi_y, &p->inv_y);
-  slab_lanes(oz, dz, &p->org_lo_z, &p->org_hi_z, &p->inv_z);
+  slab_lanes(ox, dx, &p->lo_offset_x, &p->hi_offset_x, &p->inv_x);
+  slab_lanes(oy, dy, &p->lo_offset_y, &p->hi_offset_y, &p->inv_y);
+  slab_lanes(oz, dz, &p->lo_offset_z, &p->hi_offset_z, &p->inv_z);
   p->t_min = t_min;
 }
 
@@ -84,12 +89,12 @@ FH_INLINE void make_packet(const float3* org, const float3* dir, int count, cons
 // The near distance of child `c` for each ray, +INFINITY where the ray misses it or no
 // longer needs it (t_hit: each ray's current hit, -INFINITY for rays that are done).
 FH_INLINE float8 packet_child_near(const RayPacket* p, __global const Bvh8Node* node, int c, float8 t_hit) {
-  const float8 tx0 = ((float8)(node->lo_x[c]) - p->org_lo_x) * p->inv_x;
-  const float8 tx1 = ((float8)(node->hi_x[c]) - p->org_hi_x) * p->inv_x;
-  const float8 ty0 = ((float8)(node->lo_y[c]) - p->org_lo_y) * p->inv_y;
-  const float8 ty1 = ((float8)(node->hi_y[c]) - p->org_hi_y) * p->inv_y;
-  const float8 tz0 = ((float8)(node->lo_z[c]) - p->org_lo_z) * p->inv_z;
-  const float8 tz1 = ((float8)(node->hi_z[c]) - p->org_hi_z) * p->inv_z;
+  const float8 tx0 = fma((float8)(node->lo_x[c]), p->inv_x, p->lo_offset_x);
+  const float8 tx1 = fma((float8)(node->hi_x[c]), p->inv_x, p->hi_offset_x);
+  const float8 ty0 = fma((float8)(node->lo_y[c]), p->inv_y, p->lo_offset_y);
+  const float8 ty1 = fma((float8)(node->hi_y[c]), p->inv_y, p->hi_offset_y);
+  const float8 tz0 = fma((float8)(node->lo_z[c]), p->inv_z, p->lo_offset_z);
+  const float8 tz1 = fma((float8)(node->hi_z[c]), p->inv_z, p->hi_offset_z);
   return slab_near(tx0, tx1, ty0, ty1, tz0, tz1, t_hit);
 }
 

@@ -573,8 +573,8 @@ TEST(RayConstants, EightRaysAtOnceGetEachRaysOwnBits) {
   const char* kernel = R"CL(
 FH_INLINE void put(__global uint* out, RayPrecomp r) {
   const uint v[21] = {as_uint(r.inv_dir.x), as_uint(r.inv_dir.y), as_uint(r.inv_dir.z), r.near_x, r.near_y,
-                      r.near_z, as_uint(r.org_near.x), as_uint(r.org_near.y), as_uint(r.org_near.z),
-                      as_uint(r.org_far.x), as_uint(r.org_far.y), as_uint(r.org_far.z), r.kx, r.ky, r.kz,
+                      r.near_z, as_uint(r.near_offset.x), as_uint(r.near_offset.y), as_uint(r.near_offset.z),
+                      as_uint(r.far_offset.x), as_uint(r.far_offset.y), as_uint(r.far_offset.z), r.kx, r.ky, r.kz,
                       as_uint(r.sx), as_uint(r.sy), as_uint(r.sz), as_uint(r.ox), as_uint(r.oy), as_uint(r.oz)};
   for (int k = 0; k < 21; ++k) out[k] = v[k];
 }
