@@ -27,9 +27,10 @@ FH_INLINE void fetch_child_early(__global const Bvh8Node* nodes, __global const 
 // The index of the lowest set bit of m (m != 0).
 FH_INLINE int lowest_bit64(ulong m) { return 63 - (int)clz(m & (0ul - m)); }
 
-// Bit l set where ray l (l < count) has an occluder on [t_min[l], t_max[l]).
+// Bit l set where ray l (l < count; its constants are lane l % 8 of r[l / 8]) has an
+// occluder on [t_min[l], t_max[l]).
 FH_INLINE ulong find_occluders(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
-                               const RayPrecomp* r, const float* t_min, const float* t_max, int count) {
+                               const RayPrecomp8* r, const float* t_min, const float* t_max, int count) {
   ulong open = count >= 64 ? ~0ul : (1ul << count) - 1ul;  // rays not yet occluded
   ulong occluded = 0ul;
   int stack_ref[FH_TRAVERSAL_STACK];
@@ -50,7 +51,8 @@ FH_INLINE ulong find_occluders(__global const Bvh8Node* nodes, __global const Tr
       const ulong8 lane_bit = (ulong8)(1ul, 2ul, 4ul, 8ul, 16ul, 32ul, 64ul, 128ul);
       for (ulong m = rays; m != 0ul; m &= m - 1ul) {
         const int l = lowest_bit64(m);
-        const uint hits = lane_bits(intersect_children(&r[l], node, t_max[l]) != (float8)(INFINITY));
+        const RayPrecomp ray = ray_of_lane(&r[l >> 3], l & 7);
+        const uint hits = lane_bits(intersect_children(&ray, node, t_max[l]) != (float8)(INFINITY));
         child_rays |= (((ulong8)(hits) & lane_bit) != (ulong8)(0ul) ? (ulong8)(1ul << l) : (ulong8)(0ul));
       }
       ulong pushed[8];
@@ -69,7 +71,8 @@ FH_INLINE ulong find_occluders(__global const Bvh8Node* nodes, __global const Tr
       for (ulong m = rays; m != 0ul; m &= m - 1ul) {
         const int l = lowest_bit64(m);
         float t_end = t_max[l], b1, b2;
-        if (intersect_block(&r[l], block, t_min[l], &t_end, -1, &b1, &b2, true) >= 0) occluded |= 1ul << l;
+        const RayPrecomp ray = ray_of_lane(&r[l >> 3], l & 7);
+        if (intersect_block(&ray, block, t_min[l], &t_end, -1, &b1, &b2, true) >= 0) occluded |= 1ul << l;
       }
       open &= ~occluded;
       if (open == 0ul) break;

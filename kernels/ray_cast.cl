@@ -72,13 +72,12 @@ __kernel void intersect_any_streams(__global const Bvh8Node* nodes, __global con
   const uint first = get_global_id(0) * FH_STREAM;
   if (first >= ray_count) return;
   const int count = (int)min(ray_count - first, (uint)FH_STREAM);
-  RayPrecomp r[FH_STREAM];
+  // Kept eight to a group as precompute_rays8 stores them: the traversal reads the few
+  // constants each test needs where they are, with no copy of each ray's into a structure.
+  RayPrecomp8 r[FH_STREAM / 8];
   float t_min[FH_STREAM], t_max[FH_STREAM];
-  for (int g = 0; g < count; g += 8) {
-    RayPrecomp8 eight;
-    const int n = load_rays8(ray_org, ray_dir, first + (uint)g, ray_count, &eight, t_min + g, t_max + g);
-    for (int l = 0; l < n; ++l) r[g + l] = ray_of_lane(&eight, l);
-  }
+  for (int g = 0; g < count; g += 8)
+    load_rays8(ray_org, ray_dir, first + (uint)g, ray_count, &r[g / 8], t_min + g, t_max + g);
   const ulong hit = find_occluders(nodes, blocks, r, t_min, t_max, count);
   for (int l = 0; l < count; ++l) occluded[first + l] = (int)((hit >> l) & 1ul);
 }
