@@ -73,7 +73,8 @@ typedef struct {
 // from the world's, near the box); so the entry's offset is moved down and the exit's up by
 // FH_ULP_STEP, and the distances can only widen the slab. The distance itself is then
 // rounded once, which FH_SLAB_WIDEN covers. Macros, for float3 and float8 alike (the same
-// bits).
+// bits). fma is exact on every device (OpenCL requires it), and fast where the hardware has
+// it: GPUs, and x86 CPUs since Haswell; elsewhere it is emulated, slowly.
 //
 // o * inv, clamped to the finite floats (infinity moved by a step could be NaN; the clamped
 // value still errs the right way once stepped).
