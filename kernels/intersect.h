@@ -249,18 +249,22 @@ typedef struct {
 FH_INLINE WatertightLanes watertight_lanes(float8 x0, float8 y0, float8 z0, float8 x1, float8 y1, float8 z1,
                                            float8 x2, float8 y2, float8 z2, float8 ox, float8 oy, float8 oz,
                                            float8 sx, float8 sy, float8 sz, float8 t_min, float8 t_max) {
+  // Each vertex's sheared coordinates depend on that vertex and the ray alone, so they may
+  // be fused (a vertex gets the same bits in every triangle); the edge functions below may
+  // not (see FP_CONTRACT above).
   const float8 az = z0 - oz, bz = z1 - oz, cz = z2 - oz;
-  const float8 ax = (x0 - ox) - sx * az, ay = (y0 - oy) - sy * az;
-  const float8 bx = (x1 - ox) - sx * bz, by = (y1 - oy) - sy * bz;
-  const float8 cx = (x2 - ox) - sx * cz, cy = (y2 - oy) - sy * cz;
+  const float8 ax = fma(-sx, az, x0 - ox), ay = fma(-sy, az, y0 - oy);
+  const float8 bx = fma(-sx, bz, x1 - ox), by = fma(-sy, bz, y1 - oy);
+  const float8 cx = fma(-sx, cz, x2 - ox), cy = fma(-sy, cz, y2 - oy);
   WatertightLanes e;
   const float8 u = cx * by - cy * bx;
   e.v = ax * cy - ay * cx;
   e.w = bx * ay - by * ax;
   const float8 zero = (float8)(0.0f);
-  const int8 outside = ((u < zero) | (e.v < zero) | (e.w < zero)) & ((u > zero) | (e.v > zero) | (e.w > zero));
+  // Outside where the edge functions differ in sign (a NaN among them fails the t test below).
+  const int8 outside = (min8(min8(u, e.v), e.w) < zero) & (max8(max8(u, e.v), e.w) > zero);
   e.det = u + e.v + e.w;
-  e.t_scaled = u * sz * az + e.v * sz * bz + e.w * sz * cz;
+  e.t_scaled = fma(u, sz * az, fma(e.v, sz * bz, e.w * (sz * cz)));
   // Compare t against the interval without dividing: flip by det's sign.
   const float8 abs_det = fabs(e.det);
   const float8 ts = select(e.t_scaled, -e.t_scaled, e.det < zero);
