@@ -59,7 +59,7 @@ typedef struct {
   // needs no min and max to sort each axis' two distances.
   int near_x, near_y, near_z;
   // The distance to an entry plane is plane * inv_dir + near_offset, to an exit plane
-  // plane * inv_dir + far_offset (FH_NEAR_OFFSET).
+  // plane * inv_dir + far_offset (FH_SLAB_OFFSET).
   float3 near_offset, far_offset;
   int kx, ky, kz;
   float sx, sy, sz;
@@ -85,10 +85,11 @@ typedef struct {
 // the smallest normal float: an origin at 0 would give a denormal offset, and a
 // multiply-add with a denormal operand takes a microcode assist on x86.
 #define FH_ULP_STEP(x, type) fma(fabs(x), (type)(0x1p-23f), (type)(FLT_MIN))
-#define FH_NEAR_OFFSET(o, inv, type) \
-  (-(FH_ORIGIN_TERM(o, inv, type) + FH_ULP_STEP(FH_ORIGIN_TERM(o, inv, type), type)))
-#define FH_FAR_OFFSET(o, inv, type) \
-  (-(FH_ORIGIN_TERM(o, inv, type) - FH_ULP_STEP(FH_ORIGIN_TERM(o, inv, type), type)))
+// The offset of a plane the ray enters by where `entry` is positive (stepped down), exits by
+// where it is negative (stepped up): a constant for one ray, the direction's sign for a
+// packet's low planes.
+#define FH_SLAB_OFFSET(o, inv, entry, type) \
+  (-FH_ORIGIN_TERM(o, inv, type) - copysign(FH_ULP_STEP(FH_ORIGIN_TERM(o, inv, type), type), (type)(entry)))
 
 FH_INLINE float component(float3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
 
@@ -125,8 +126,8 @@ FH_INLINE RayPrecomp precompute_ray(float3 org, float3 dir) {
   r.near_x = forward.x ? 0 : 8;
   r.near_y = forward.y ? 16 : 24;
   r.near_z = forward.z ? 32 : 40;
-  r.near_offset = FH_NEAR_OFFSET(select(org_hi, org_lo, forward), r.inv_dir, float3);
-  r.far_offset = FH_FAR_OFFSET(select(org_lo, org_hi, forward), r.inv_dir, float3);
+  r.near_offset = FH_SLAB_OFFSET(select(org_hi, org_lo, forward), r.inv_dir, 1.0f, float3);
+  r.far_offset = FH_SLAB_OFFSET(select(org_lo, org_hi, forward), r.inv_dir, -1.0f, float3);
   return r;
 }
 
@@ -193,12 +194,12 @@ FH_INLINE void precompute_rays8(float8 ox, float8 oy, float8 oz, float8 dx, floa
   vstore8(select((int8)(8), zero, fwd_x), 0, r->near_x);
   vstore8(select((int8)(24), (int8)(16), fwd_y), 0, r->near_y);
   vstore8(select((int8)(40), (int8)(32), fwd_z), 0, r->near_z);
-  vstore8(FH_NEAR_OFFSET(select(hi_x, lo_x, fwd_x), inv_x, float8), 0, r->near_offset_x);
-  vstore8(FH_NEAR_OFFSET(select(hi_y, lo_y, fwd_y), inv_y, float8), 0, r->near_offset_y);
-  vstore8(FH_NEAR_OFFSET(select(hi_z, lo_z, fwd_z), inv_z, float8), 0, r->near_offset_z);
-  vstore8(FH_FAR_OFFSET(select(lo_x, hi_x, fwd_x), inv_x, float8), 0, r->far_offset_x);
-  vstore8(FH_FAR_OFFSET(select(lo_y, hi_y, fwd_y), inv_y, float8), 0, r->far_offset_y);
-  vstore8(FH_FAR_OFFSET(select(lo_z, hi_z, fwd_z), inv_z, float8), 0, r->far_offset_z);
+  vstore8(FH_SLAB_OFFSET(select(hi_x, lo_x, fwd_x), inv_x, 1.0f, float8), 0, r->near_offset_x);
+  vstore8(FH_SLAB_OFFSET(select(hi_y, lo_y, fwd_y), inv_y, 1.0f, float8), 0, r->near_offset_y);
+  vstore8(FH_SLAB_OFFSET(select(hi_z, lo_z, fwd_z), inv_z, 1.0f, float8), 0, r->near_offset_z);
+  vstore8(FH_SLAB_OFFSET(select(lo_x, hi_x, fwd_x), inv_x, -1.0f, float8), 0, r->far_offset_x);
+  vstore8(FH_SLAB_OFFSET(select(lo_y, hi_y, fwd_y), inv_y, -1.0f, float8), 0, r->far_offset_y);
+  vstore8(FH_SLAB_OFFSET(select(lo_z, hi_z, fwd_z), inv_z, -1.0f, float8), 0, r->far_offset_z);
 }
 
 // Ray l's constants from precompute_rays8.

@@ -18,7 +18,7 @@
 // scalars, so a triangle's components load once for all lanes, and otherwise each lane
 // picks its own three (packets of incoherent rays, on small trees).
 typedef struct {
-  float8 lo_offset_x, lo_offset_y, lo_offset_z, hi_offset_x, hi_offset_y, hi_offset_z;  // FH_NEAR_OFFSET, per plane
+  float8 lo_offset_x, lo_offset_y, lo_offset_z, hi_offset_x, hi_offset_y, hi_offset_z;  // FH_SLAB_OFFSET, per plane
   float8 inv_x, inv_y, inv_z;
   float8 sx, sy, sz, ox, oy, oz;
   float8 t_min;
@@ -35,11 +35,8 @@ FH_INLINE void slab_lanes(float8 o, float8 d, float8* lo_offset, float8* hi_offs
   const float8 eps = fmax(fabs(o), (float8)(1.0f)) * 0x1p-20f;
   *inv = 1.0f / select(d, tiny, flat);
   const float8 org_lo = select(o, o + eps, flat), org_hi = select(o, o - eps, flat);
-  // FH_NEAR_OFFSET and FH_FAR_OFFSET (the same bits: -(a + b) is -a - b), the step's sign
-  // picked by the direction's instead of a select between the two.
-  const float8 lo = FH_ORIGIN_TERM(org_lo, *inv, float8), hi = FH_ORIGIN_TERM(org_hi, *inv, float8);
-  *lo_offset = -lo - copysign(FH_ULP_STEP(lo, float8), *inv);
-  *hi_offset = -hi + copysign(FH_ULP_STEP(hi, float8), *inv);
+  *lo_offset = FH_SLAB_OFFSET(org_lo, *inv, *inv, float8);
+  *hi_offset = FH_SLAB_OFFSET(org_hi, *inv, -*inv, float8);
 }
 
 // precompute_ray for ray l in lane l, all lanes at once (the same operations, so the same
