@@ -332,12 +332,19 @@ FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8
 // ray touches (Ize, "Robust BVH Ray Traversal", JCGT 2013).
 #define FH_SLAB_WIDEN 1.0000003576f
 
-// The slab test's near distance from each axis' entry and exit distances, +INFINITY where
-// the slabs' intersection, clipped to [0, t_max], is empty. Single rays (eight children)
-// and packets (eight rays) both end their box tests here, so both cull the same boxes.
+// The slab test's interval from each axis' entry and exit distances, clipped to [0, t_max]
+// and its far end widened; empty where *t_near > *t_far. Single rays (eight children) and
+// packets (eight rays) both end their box tests here, so both cull the same boxes.
+FH_INLINE void slab_interval(float8 nx, float8 ny, float8 nz, float8 fx, float8 fy, float8 fz, float8 t_max,
+                             float8* t_near, float8* t_far) {
+  *t_near = max8(max8(nx, ny), max8(nz, (float8)(0.0f)));
+  *t_far = min8(min8(fx, fy), min8(fz, t_max)) * FH_SLAB_WIDEN;
+}
+
+// The slab test's near distance, +INFINITY where the interval is empty.
 FH_INLINE float8 slab_entry(float8 nx, float8 ny, float8 nz, float8 fx, float8 fy, float8 fz, float8 t_max) {
-  const float8 t_near = max8(max8(nx, ny), max8(nz, (float8)(0.0f)));
-  const float8 t_far = min8(min8(fx, fy), min8(fz, t_max)) * FH_SLAB_WIDEN;
+  float8 t_near, t_far;
+  slab_interval(nx, ny, nz, fx, fy, fz, t_max, &t_near, &t_far);
   return select(t_near, (float8)(INFINITY), t_near > t_far);
 }
 
@@ -348,10 +355,11 @@ FH_INLINE float8 slab_near(float8 tx0, float8 tx1, float8 ty0, float8 ty1, float
                     t_max);
 }
 
-// Near distances of the eight children; lanes the ray misses get +INFINITY. Each axis'
-// entry and exit distances are the two the slab test would sort into its min and max
-// (the same bits: a positive inverse keeps low before high, a negative one swaps them).
-FH_INLINE float8 intersect_children(const RayPrecomp* r, __global const Bvh8Node* node, float t_max) {
+// The slab intervals of the eight children. Each axis' entry and exit distances are the
+// two the slab test would sort into its min and max (the same bits: a positive inverse
+// keeps low before high, a negative one swaps them).
+FH_INLINE void child_intervals(const RayPrecomp* r, __global const Bvh8Node* node, float t_max, float8* t_near,
+                               float8* t_far) {
   __global const float* planes = (__global const float*)node;
   const float8 ix = (float8)(r->inv_dir.x), iy = (float8)(r->inv_dir.y), iz = (float8)(r->inv_dir.z);
   const float8 nx = fma(vload8(0, planes + r->near_x), ix, (float8)(r->near_offset.x));
@@ -360,8 +368,15 @@ FH_INLINE float8 intersect_children(const RayPrecomp* r, __global const Bvh8Node
   const float8 fy = fma(vload8(0, planes + (r->near_y ^ 8)), iy, (float8)(r->far_offset.y));
   const float8 nz = fma(vload8(0, planes + r->near_z), iz, (float8)(r->near_offset.z));
   const float8 fz = fma(vload8(0, planes + (r->near_z ^ 8)), iz, (float8)(r->far_offset.z));
+  slab_interval(nx, ny, nz, fx, fy, fz, (float8)(t_max), t_near, t_far);
+}
+
+// Near distances of the eight children; lanes the ray misses, and empty slots, get +INFINITY.
+FH_INLINE float8 intersect_children(const RayPrecomp* r, __global const Bvh8Node* node, float t_max) {
+  float8 t_near, t_far;
+  child_intervals(r, node, t_max, &t_near, &t_far);
   const int8 empty = vload8(0, node->child) == (int8)(0);
-  return select(slab_entry(nx, ny, nz, fx, fy, fz, (float8)(t_max)), (float8)(INFINITY), empty);
+  return select(t_near, (float8)(INFINITY), (t_near > t_far) | empty);
 }
 
 typedef struct {

@@ -48,12 +48,14 @@ FH_INLINE ulong find_occluders(__global const Bvh8Node* nodes, __global const Tr
       // Lane c: the rays that hit child c. A ray's eight hit bits are spread over the lanes
       // in one step, where a loop over them mispredicts.
       ulong8 child_rays = (ulong8)(0ul);
-      const ulong8 lane_bit = (ulong8)(1ul, 2ul, 4ul, 8ul, 16ul, 32ul, 64ul, 128ul);
+      const int8 filled = vload8(0, node->child) != (int8)(0);
       for (ulong m = rays; m != 0ul; m &= m - 1ul) {
         const int l = lowest_bit64(m);
         const RayPrecomp ray = ray_of_lane(&r[l >> 3], l & 7);
-        const uint hits = lane_bits(intersect_children(&ray, node, t_max[l]) != (float8)(INFINITY));
-        child_rays |= (((ulong8)(hits) & lane_bit) != (ulong8)(0ul) ? (ulong8)(1ul << l) : (ulong8)(0ul));
+        float8 t_near, t_far;
+        child_intervals(&ray, node, t_max[l], &t_near, &t_far);
+        const int8 hits = ~(t_near > t_far) & (t_near != (float8)(INFINITY)) & filled;
+        child_rays |= select((ulong8)(0ul), (ulong8)(1ul << l), convert_long8(hits));
       }
       ulong pushed[8];
       vstore8(child_rays, 0, pushed);
