@@ -131,16 +131,19 @@ FH_INLINE RayPrecomp precompute_ray(float3 org, float3 dir) {
   return r;
 }
 
+// RayPrecomp's fields as arrays over rays, ray l's at index l, so that a traversal reads its
+// ray's constants with plain loads (FH_RAY_AT): X(type, name) for each.
+#define FH_RAY_CONSTANTS(X)                                                                       \
+  X(float, inv_x) X(float, inv_y) X(float, inv_z) X(int, near_x) X(int, near_y) X(int, near_z)    \
+  X(float, near_offset_x) X(float, near_offset_y) X(float, near_offset_z) X(float, far_offset_x) \
+  X(float, far_offset_y) X(float, far_offset_z) X(int, kx) X(int, ky) X(int, kz) X(float, sx)     \
+  X(float, sy) X(float, sz) X(float, ox) X(float, oy) X(float, oz)
+#define FH_EIGHT_OF(type, name) type name[8];
+
 // precompute_ray for eight rays, ray l in lane l: the same operations on the same values
-// (the same bits), with one vector division where eight rays took a scalar one each. Kept
-// as arrays, so a traversal reads its ray's constants (ray_of_lane) with plain loads.
+// (the same bits), with one vector division where eight rays took a scalar one each.
 typedef struct {
-  float inv_x[8], inv_y[8], inv_z[8];
-  int near_x[8], near_y[8], near_z[8];
-  float near_offset_x[8], near_offset_y[8], near_offset_z[8], far_offset_x[8], far_offset_y[8], far_offset_z[8];
-  int kx[8], ky[8], kz[8];
-  float sx[8], sy[8], sz[8];
-  float ox[8], oy[8], oz[8];
+  FH_RAY_CONSTANTS(FH_EIGHT_OF)
 } RayPrecomp8;
 
 // Component k (0: x, 1: y, 2: z) of (x, y, z), per lane.
@@ -202,24 +205,30 @@ FH_INLINE void precompute_rays8(float8 ox, float8 oy, float8 oz, float8 dx, floa
   vstore8(FH_SLAB_OFFSET(select(lo_z, hi_z, fwd_z), inv_z, -1.0f, float8), 0, r->far_offset_z);
 }
 
+// Ray l's constants, into the RayPrecomp r, from arrays laid out by FH_RAY_CONSTANTS.
+#define FH_RAY_AT(s, l, r)                                                                   \
+  do {                                                                                       \
+    (r).inv_dir = (float3)((s)->inv_x[l], (s)->inv_y[l], (s)->inv_z[l]);                     \
+    (r).near_x = (s)->near_x[l];                                                             \
+    (r).near_y = (s)->near_y[l];                                                             \
+    (r).near_z = (s)->near_z[l];                                                             \
+    (r).near_offset = (float3)((s)->near_offset_x[l], (s)->near_offset_y[l], (s)->near_offset_z[l]); \
+    (r).far_offset = (float3)((s)->far_offset_x[l], (s)->far_offset_y[l], (s)->far_offset_z[l]);     \
+    (r).kx = (s)->kx[l];                                                                     \
+    (r).ky = (s)->ky[l];                                                                     \
+    (r).kz = (s)->kz[l];                                                                     \
+    (r).sx = (s)->sx[l];                                                                     \
+    (r).sy = (s)->sy[l];                                                                     \
+    (r).sz = (s)->sz[l];                                                                     \
+    (r).ox = (s)->ox[l];                                                                     \
+    (r).oy = (s)->oy[l];                                                                     \
+    (r).oz = (s)->oz[l];                                                                     \
+  } while (0)
+
 // Ray l's constants from precompute_rays8.
 FH_INLINE RayPrecomp ray_of_lane(const RayPrecomp8* s, int l) {
   RayPrecomp r;
-  r.inv_dir = (float3)(s->inv_x[l], s->inv_y[l], s->inv_z[l]);
-  r.near_x = s->near_x[l];
-  r.near_y = s->near_y[l];
-  r.near_z = s->near_z[l];
-  r.near_offset = (float3)(s->near_offset_x[l], s->near_offset_y[l], s->near_offset_z[l]);
-  r.far_offset = (float3)(s->far_offset_x[l], s->far_offset_y[l], s->far_offset_z[l]);
-  r.kx = s->kx[l];
-  r.ky = s->ky[l];
-  r.kz = s->kz[l];
-  r.sx = s->sx[l];
-  r.sy = s->sy[l];
-  r.sz = s->sz[l];
-  r.ox = s->ox[l];
-  r.oy = s->oy[l];
-  r.oz = s->oz[l];
+  FH_RAY_AT(s, l, r);
   return r;
 }
 

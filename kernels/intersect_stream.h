@@ -12,29 +12,40 @@
 
 #include "intersect.h"
 
-// Asks for a child's lines (a node's boxes or a leaf's triangles) ahead of its visit, for
-// children that wait on the stack a while before they are popped: every other 64-byte
-// line, as x86 caches fetch lines in pairs. x86 only (the hint is a Clang built-in);
-// elsewhere nothing.
-FH_INLINE void fetch_child_early(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, int child) {
-#ifdef __AVX__
-  __global const char* p = child >= 0 ? (__global const char*)(nodes + child) : (__global const char*)(blocks + ~child);
-  const int bytes = child >= 0 ? (int)sizeof(Bvh8Node) : (int)sizeof(TriangleBlock8);
-  for (int offset = 0; offset < bytes; offset += 128) __builtin_prefetch(p + offset);
+// A stream's rays: each ray's constants and segment, ray l's at index l of every array, so
+// that a test finds them at one offset from the stream's start.
+#define FH_STREAM_OF(type, name) type name[FH_STREAM];
+typedef struct {
+  FH_RAY_CONSTANTS(FH_STREAM_OF)
+  float t_min[FH_STREAM], t_max[FH_STREAM];
+} RayStream;
+
+// Rays [g, g + 8) of the stream from eight set up together.
+FH_INLINE void add_rays8(RayStream* s, int g, const RayPrecomp8* r, const float* t_min, const float* t_max) {
+#define FH_COPY_EIGHT(type, name) vstore8(vload8(0, r->name), 0, s->name + g);
+  FH_RAY_CONSTANTS(FH_COPY_EIGHT)
+#undef FH_COPY_EIGHT
+  vstore8(vload8(0, t_min), 0, s->t_min + g);
+  vstore8(vload8(0, t_max), 0, s->t_max + g);
+}
+
+// The index of the lowest set bit of m (m != 0): on x86 one instruction (tzcnt) where clz
+// takes four; OpenCL 1.2 has no ctz.
+FH_INLINE int lowest_bit64(ulong m) {
+#ifdef __AVX2__
+  return __builtin_ctzl(m);
+#else
+  return 63 - (int)clz(m & (0ul - m));
 #endif
 }
 
-// The index of the lowest set bit of m (m != 0).
-FH_INLINE int lowest_bit64(ulong m) { return 63 - (int)clz(m & (0ul - m)); }
-
-// Bit l set where ray l (l < count; its constants are lane l % 8 of r[l / 8]) has an
-// occluder on [t_min[l], t_max[l]).
+// Bit l set where ray l of the stream (l < count) has an occluder on its segment.
 FH_INLINE ulong find_occluders(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
-                               const RayPrecomp8* r, const float* t_min, const float* t_max, int count) {
+                               const RayStream* s, int count) {
   ulong open = count >= 64 ? ~0ul : (1ul << count) - 1ul;  // rays not yet occluded
   ulong occluded = 0ul;
-  int stack_ref[FH_TRAVERSAL_STACK];
-  ulong stack_rays[FH_TRAVERSAL_STACK];
+  int stack_ref[FH_TRAVERSAL_STACK + 8];
+  ulong stack_rays[FH_TRAVERSAL_STACK + 8];
   int sp = 0;
   stack_ref[sp] = 0;  // the root
   stack_rays[sp++] = open;
@@ -45,36 +56,36 @@ FH_INLINE ulong find_occluders(__global const Bvh8Node* nodes, __global const Tr
     if (rays == 0ul) continue;
     if (ref >= 0) {
       __global const Bvh8Node* node = nodes + ref;
-      // Lane c: the rays that hit child c. A ray's eight hit bits are spread over the lanes
-      // in one step, where a loop over them mispredicts.
+      // Lane c: the rays that hit child c.
       ulong8 child_rays = (ulong8)(0ul);
-      const int8 filled = vload8(0, node->child) != (int8)(0);
       for (ulong m = rays; m != 0ul; m &= m - 1ul) {
         const int l = lowest_bit64(m);
-        const RayPrecomp ray = ray_of_lane(&r[l >> 3], l & 7);
+        RayPrecomp ray;
+        FH_RAY_AT(s, l, ray);
         float8 t_near, t_far;
-        child_intervals(&ray, node, t_max[l], &t_near, &t_far);
-        const int8 hits = ~(t_near > t_far) & (t_near != (float8)(INFINITY)) & filled;
+        child_intervals(&ray, node, s->t_max[l], &t_near, &t_far);
+        const int8 hits = ~(t_near > t_far) & (t_near != (float8)(INFINITY));
         child_rays |= select((ulong8)(0ul), (ulong8)(1ul << l), convert_long8(hits));
       }
+      child_rays = select((ulong8)(0ul), child_rays, convert_long8(vload8(0, node->child) != (int8)(0)));
+      // Every slot pushed, last to first so the children are visited in lane order; the
+      // stack pointer skips the children no ray reached, where a loop over those reached
+      // would mispredict its branches.
       ulong pushed[8];
       vstore8(child_rays, 0, pushed);
-      // The children some ray hit, pushed last to first so they are visited in lane order.
-      const int8 reached = convert_int8(child_rays != (ulong8)(0ul));
-      for (uint c = lane_bits(reached); c != 0u; c &= ~(0x80000000u >> clz(c))) {
-        const int highest = 31 - (int)clz(c);
-        const int child = node->child[highest];
-        fetch_child_early(nodes, blocks, child);
-        stack_ref[sp] = child;
-        stack_rays[sp++] = pushed[highest];
+      _Pragma("unroll") for (int c = 7; c >= 0; --c) {
+        stack_ref[sp] = node->child[c];
+        stack_rays[sp] = pushed[c];
+        sp += pushed[c] != 0ul;
       }
     } else {
       __global const TriangleBlock8* block = blocks + ~ref;
       for (ulong m = rays; m != 0ul; m &= m - 1ul) {
         const int l = lowest_bit64(m);
-        float t_end = t_max[l], b1, b2;
-        const RayPrecomp ray = ray_of_lane(&r[l >> 3], l & 7);
-        if (intersect_block(&ray, block, t_min[l], &t_end, -1, &b1, &b2, true) >= 0) occluded |= 1ul << l;
+        float t_end = s->t_max[l], b1, b2;
+        RayPrecomp ray;
+        FH_RAY_AT(s, l, ray);
+        if (intersect_block(&ray, block, s->t_min[l], &t_end, -1, &b1, &b2, true) >= 0) occluded |= 1ul << l;
       }
       open &= ~occluded;
       if (open == 0ul) break;

@@ -72,13 +72,14 @@ __kernel void intersect_any_streams(__global const Bvh8Node* nodes, __global con
   const uint first = get_global_id(0) * FH_STREAM;
   if (first >= ray_count) return;
   const int count = (int)min(ray_count - first, (uint)FH_STREAM);
-  // Kept eight to a group as precompute_rays8 stores them: the traversal reads the few
-  // constants each test needs where they are, with no copy of each ray's into a structure.
-  RayPrecomp8 r[FH_STREAM / 8];
-  float t_min[FH_STREAM], t_max[FH_STREAM];
-  for (int g = 0; g < count; g += 8)
-    load_rays8(ray_org, ray_dir, first + (uint)g, ray_count, &r[g / 8], t_min + g, t_max + g);
-  const ulong hit = find_occluders(nodes, blocks, r, t_min, t_max, count);
+  RayStream stream;
+  for (int g = 0; g < count; g += 8) {
+    RayPrecomp8 r;
+    float t_min[8], t_max[8];
+    load_rays8(ray_org, ray_dir, first + (uint)g, ray_count, &r, t_min, t_max);
+    add_rays8(&stream, g, &r, t_min, t_max);
+  }
+  const ulong hit = find_occluders(nodes, blocks, &stream, count);
   for (int l = 0; l < count; ++l) occluded[first + l] = (int)((hit >> l) & 1ul);
 }
 
