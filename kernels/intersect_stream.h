@@ -39,6 +39,38 @@ FH_INLINE int lowest_bit64(ulong m) {
 #endif
 }
 
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+typedef long fh_v8di __attribute__((vector_size(64)));
+#endif
+
+// Pushes the children some ray reaches (child_rays != 0), each with its rays, last lane
+// first so that they are popped in lane order. No branch per child: where a loop over the
+// children reached mispredicts, AVX-512 packs them together in one instruction per array,
+// and elsewhere every slot is stored and the stack pointer moves past those reached. The
+// stack needs eight entries of room past its deepest use.
+FH_INLINE void push_children(ulong8 child_rays, int8 child, int* stack_ref, ulong* stack_rays, int* sp) {
+  const ulong8 rays = shuffle(child_rays, (ulong8)(7, 6, 5, 4, 3, 2, 1, 0));
+  const int8 refs = shuffle(child, (uint8)(7, 6, 5, 4, 3, 2, 1, 0));
+#if defined(__AVX512F__) && defined(__AVX512VL__) && !defined(FH_PORTABLE_PUSH)
+  const uchar reached = (uchar)lane_bits(convert_int8(rays != (ulong8)(0ul)));
+  vstore8(as_ulong8(__builtin_ia32_compressdi512_mask((fh_v8di)rays, (fh_v8di)(ulong8)(0ul), reached)), 0,
+          stack_rays + *sp);
+  vstore8(as_int8(__builtin_ia32_compresssi256_mask((fh_v8si)refs, (fh_v8si)(int8)(0), reached)), 0,
+          stack_ref + *sp);
+  *sp += (int)popcount((uint)reached);
+#else
+  ulong r[8];
+  int c[8];
+  vstore8(rays, 0, r);
+  vstore8(refs, 0, c);
+  _Pragma("unroll") for (int i = 0; i < 8; ++i) {
+    stack_ref[*sp] = c[i];
+    stack_rays[*sp] = r[i];
+    *sp += r[i] != 0ul;
+  }
+#endif
+}
+
 // Bit l set where ray l of the stream (l < count) has an occluder on its segment.
 FH_INLINE ulong find_occluders(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks,
                                const RayStream* s, int count) {
@@ -68,16 +100,7 @@ FH_INLINE ulong find_occluders(__global const Bvh8Node* nodes, __global const Tr
         child_rays |= select((ulong8)(0ul), (ulong8)(1ul << l), convert_long8(hits));
       }
       child_rays = select((ulong8)(0ul), child_rays, convert_long8(vload8(0, node->child) != (int8)(0)));
-      // Every slot pushed, last to first so the children are visited in lane order; the
-      // stack pointer skips the children no ray reached, where a loop over those reached
-      // would mispredict its branches.
-      ulong pushed[8];
-      vstore8(child_rays, 0, pushed);
-      _Pragma("unroll") for (int c = 7; c >= 0; --c) {
-        stack_ref[sp] = node->child[c];
-        stack_rays[sp] = pushed[c];
-        sp += pushed[c] != 0ul;
-      }
+      push_children(child_rays, vload8(0, node->child), stack_ref, stack_rays, &sp);
     } else {
       __global const TriangleBlock8* block = blocks + ~ref;
       for (ulong m = rays; m != 0ul; m &= m - 1ul) {
