@@ -140,11 +140,16 @@ FH_INLINE RayPrecomp precompute_ray(float3 org, float3 dir) {
   X(float, sy) X(float, sz) X(float, ox) X(float, oy) X(float, oz)
 #define FH_EIGHT_OF(type, name) type name[8];
 
-// precompute_ray for eight rays, ray l in lane l: the same operations on the same values
-// (the same bits), with one vector division where eight rays took a scalar one each.
+// Eight rays' constants (precompute_rays8).
 typedef struct {
   FH_RAY_CONSTANTS(FH_EIGHT_OF)
 } RayPrecomp8;
+
+// The same constants in vector lanes, ray l's in lane l, as they are computed.
+#define FH_LANES_OF(type, name) type##8 name;
+typedef struct {
+  FH_RAY_CONSTANTS(FH_LANES_OF)
+} RayLanes8;
 
 // Component k (0: x, 1: y, 2: z) of (x, y, z), per lane.
 FH_INLINE float8 component8(float8 x, float8 y, float8 z, int8 k) {
@@ -165,21 +170,24 @@ FH_INLINE void axis_orders8(float8 dx, float8 dy, float8 dz, int8* kx, int8* ky,
   *ky = select(y, x, down);
 }
 
-FH_INLINE void precompute_rays8(float8 ox, float8 oy, float8 oz, float8 dx, float8 dy, float8 dz, RayPrecomp8* r) {
+// precompute_ray for eight rays, ray l in lane l: the same operations on the same values
+// (the same bits), with one vector division where eight rays took a scalar one each.
+FH_INLINE RayLanes8 ray_constants8(float8 ox, float8 oy, float8 oz, float8 dx, float8 dy, float8 dz) {
+  RayLanes8 lanes;
   const float8 ax = fabs(dx), ay = fabs(dy), az = fabs(dz);
   const int8 zero = (int8)(0);
   int8 kx, ky, kz;
   float8 along;
   axis_orders8(dx, dy, dz, &kx, &ky, &kz, &along);
-  vstore8(kx, 0, r->kx);
-  vstore8(ky, 0, r->ky);
-  vstore8(kz, 0, r->kz);
-  vstore8(component8(dx, dy, dz, kx) / along, 0, r->sx);
-  vstore8(component8(dx, dy, dz, ky) / along, 0, r->sy);
-  vstore8(1.0f / along, 0, r->sz);
-  vstore8(component8(ox, oy, oz, kx), 0, r->ox);
-  vstore8(component8(ox, oy, oz, ky), 0, r->oy);
-  vstore8(component8(ox, oy, oz, kz), 0, r->oz);
+  lanes.kx = kx;
+  lanes.ky = ky;
+  lanes.kz = kz;
+  lanes.sx = component8(dx, dy, dz, kx) / along;
+  lanes.sy = component8(dx, dy, dz, ky) / along;
+  lanes.sz = 1.0f / along;
+  lanes.ox = component8(ox, oy, oz, kx);
+  lanes.oy = component8(ox, oy, oz, ky);
+  lanes.oz = component8(ox, oy, oz, kz);
   // Zero direction components as precompute_ray treats them, one axis at a time.
   const float8 tiny = (float8)(1e-30f), one = (float8)(1.0f);
   const int8 flat_x = ax < tiny, flat_y = ay < tiny, flat_z = az < tiny;
@@ -187,22 +195,35 @@ FH_INLINE void precompute_rays8(float8 ox, float8 oy, float8 oz, float8 dx, floa
                eps_z = fmax(fabs(oz), one) * 0x1p-20f;
   const float8 inv_x = 1.0f / select(dx, tiny, flat_x), inv_y = 1.0f / select(dy, tiny, flat_y),
                inv_z = 1.0f / select(dz, tiny, flat_z);
-  vstore8(inv_x, 0, r->inv_x);
-  vstore8(inv_y, 0, r->inv_y);
-  vstore8(inv_z, 0, r->inv_z);
+  lanes.inv_x = inv_x;
+  lanes.inv_y = inv_y;
+  lanes.inv_z = inv_z;
   const float8 lo_x = select(ox, ox + eps_x, flat_x), hi_x = select(ox, ox - eps_x, flat_x);
   const float8 lo_y = select(oy, oy + eps_y, flat_y), hi_y = select(oy, oy - eps_y, flat_y);
   const float8 lo_z = select(oz, oz + eps_z, flat_z), hi_z = select(oz, oz - eps_z, flat_z);
   const int8 fwd_x = inv_x >= (float8)(0.0f), fwd_y = inv_y >= (float8)(0.0f), fwd_z = inv_z >= (float8)(0.0f);
-  vstore8(select((int8)(8), zero, fwd_x), 0, r->near_x);
-  vstore8(select((int8)(24), (int8)(16), fwd_y), 0, r->near_y);
-  vstore8(select((int8)(40), (int8)(32), fwd_z), 0, r->near_z);
-  vstore8(FH_SLAB_OFFSET(select(hi_x, lo_x, fwd_x), inv_x, 1.0f, float8), 0, r->near_offset_x);
-  vstore8(FH_SLAB_OFFSET(select(hi_y, lo_y, fwd_y), inv_y, 1.0f, float8), 0, r->near_offset_y);
-  vstore8(FH_SLAB_OFFSET(select(hi_z, lo_z, fwd_z), inv_z, 1.0f, float8), 0, r->near_offset_z);
-  vstore8(FH_SLAB_OFFSET(select(lo_x, hi_x, fwd_x), inv_x, -1.0f, float8), 0, r->far_offset_x);
-  vstore8(FH_SLAB_OFFSET(select(lo_y, hi_y, fwd_y), inv_y, -1.0f, float8), 0, r->far_offset_y);
-  vstore8(FH_SLAB_OFFSET(select(lo_z, hi_z, fwd_z), inv_z, -1.0f, float8), 0, r->far_offset_z);
+  lanes.near_x = select((int8)(8), zero, fwd_x);
+  lanes.near_y = select((int8)(24), (int8)(16), fwd_y);
+  lanes.near_z = select((int8)(40), (int8)(32), fwd_z);
+  lanes.near_offset_x = FH_SLAB_OFFSET(select(hi_x, lo_x, fwd_x), inv_x, 1.0f, float8);
+  lanes.near_offset_y = FH_SLAB_OFFSET(select(hi_y, lo_y, fwd_y), inv_y, 1.0f, float8);
+  lanes.near_offset_z = FH_SLAB_OFFSET(select(hi_z, lo_z, fwd_z), inv_z, 1.0f, float8);
+  lanes.far_offset_x = FH_SLAB_OFFSET(select(lo_x, hi_x, fwd_x), inv_x, -1.0f, float8);
+  lanes.far_offset_y = FH_SLAB_OFFSET(select(lo_y, hi_y, fwd_y), inv_y, -1.0f, float8);
+  lanes.far_offset_z = FH_SLAB_OFFSET(select(lo_z, hi_z, fwd_z), inv_z, -1.0f, float8);
+  return lanes;
+}
+
+// Stores eight rays' constants (RayLanes8 lanes) at index `at` of each of out's arrays.
+#define FH_STORE_LANES_OF(type, name) vstore8(lanes.name, 0, out->name + at);
+
+FH_INLINE void store_rays8(RayPrecomp8* out, RayLanes8 lanes) {
+  const int at = 0;
+  FH_RAY_CONSTANTS(FH_STORE_LANES_OF)
+}
+
+FH_INLINE void precompute_rays8(float8 ox, float8 oy, float8 oz, float8 dx, float8 dy, float8 dz, RayPrecomp8* out) {
+  store_rays8(out, ray_constants8(ox, oy, oz, dx, dy, dz));
 }
 
 // Ray l's constants, into the RayPrecomp r, from arrays laid out by FH_RAY_CONSTANTS.

@@ -20,13 +20,11 @@ typedef struct {
   float t_min[FH_STREAM], t_max[FH_STREAM];
 } RayStream;
 
-// Rays [g, g + 8) of the stream from eight set up together.
-FH_INLINE void add_rays8(RayStream* s, int g, const RayPrecomp8* r, const float* t_min, const float* t_max) {
-#define FH_COPY_EIGHT(type, name) vstore8(vload8(0, r->name), 0, s->name + g);
-  FH_RAY_CONSTANTS(FH_COPY_EIGHT)
-#undef FH_COPY_EIGHT
-  vstore8(vload8(0, t_min), 0, s->t_min + g);
-  vstore8(vload8(0, t_max), 0, s->t_max + g);
+// Rays [at, at + 8) of the stream from eight set up together.
+FH_INLINE void add_rays8(RayStream* out, int at, RayLanes8 lanes, float8 t_min, float8 t_max) {
+  FH_RAY_CONSTANTS(FH_STORE_LANES_OF)
+  vstore8(t_min, 0, out->t_min + at);
+  vstore8(t_max, 0, out->t_max + at);
 }
 
 // The index of the lowest set bit of m (m != 0): on x86 one instruction (tzcnt) where clz
