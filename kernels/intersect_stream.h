@@ -112,7 +112,10 @@ FH_INLINE ulong find_occluders(__global const Bvh8Node* nodes, __global const Tr
         FH_RAY_AT(s, l, ray);
         float8 t_near, t_far;
         child_intervals(&ray, node, s->t_max[l], &t_near, &t_far);
-        const int8 hits = ~(t_near > t_far) & (t_near != (float8)(INFINITY));
+        // intersect_children's misses, but for a box at infinity on an endless segment (t_near
+        // and t_far both +INFINITY, which needs t_max = +INFINITY), whose leaves are then
+        // tested exactly: the same answers, one comparison fewer per ray.
+        const int8 hits = ~(t_near > t_far);
         child_rays |= select((ulong8)(0ul), (ulong8)(1ul << l), convert_long8(hits));
       }
       child_rays = select((ulong8)(0ul), child_rays, convert_long8(vload8(0, node->child) != (int8)(0)));
