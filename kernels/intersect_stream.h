@@ -59,30 +59,38 @@ FH_INLINE bool block_occludes(const RayPrecomp* r, __global const TriangleBlock8
 typedef long fh_v8di __attribute__((vector_size(64)));
 #endif
 
-// Pushes the children some ray reaches (child_rays != 0), each with its rays, last lane
-// first so that they are popped in lane order. No branch per child: where a loop over the
-// children reached mispredicts, AVX-512 packs them together in one instruction per array,
-// and elsewhere every slot is stored and the stack pointer moves past those reached. The
-// stack needs eight entries of room past its deepest use.
+// Pushes the children some ray reaches (child_rays != 0), each with its rays: the inner
+// nodes first, then the leaves, so that leaves are popped first (a leaf is one test and may
+// end its rays, where a node opens a subtree), each kind last lane first so that it is
+// popped in lane order (the binary tree's order, left before right). No branch per child:
+// where a loop over the children reached mispredicts, AVX-512 packs them together in one
+// instruction per array, and elsewhere every slot is stored and the stack pointer moves
+// past those reached. The stack needs eight entries of room past its deepest use.
 FH_INLINE void push_children(ulong8 child_rays, int8 child, int* stack_ref, ulong* stack_rays, int* sp) {
   const ulong8 rays = shuffle(child_rays, (ulong8)(7, 6, 5, 4, 3, 2, 1, 0));
   const int8 refs = shuffle(child, (uint8)(7, 6, 5, 4, 3, 2, 1, 0));
+  const uint reached = lane_bits(convert_int8(rays != (ulong8)(0ul))), leaves = lane_bits(refs);
+  const uint kinds[2] = {reached & ~leaves, reached & leaves};
 #if defined(__AVX512F__) && defined(__AVX512VL__) && !defined(FH_PORTABLE_PUSH)
-  const uchar reached = (uchar)lane_bits(convert_int8(rays != (ulong8)(0ul)));
-  vstore8(as_ulong8(__builtin_ia32_compressdi512_mask((fh_v8di)rays, (fh_v8di)(ulong8)(0ul), reached)), 0,
-          stack_rays + *sp);
-  vstore8(as_int8(__builtin_ia32_compresssi256_mask((fh_v8si)refs, (fh_v8si)(int8)(0), reached)), 0,
-          stack_ref + *sp);
-  *sp += (int)popcount((uint)reached);
+  for (int k = 0; k < 2; ++k) {
+    const uchar lanes = (uchar)kinds[k];
+    vstore8(as_ulong8(__builtin_ia32_compressdi512_mask((fh_v8di)rays, (fh_v8di)(ulong8)(0ul), lanes)), 0,
+            stack_rays + *sp);
+    vstore8(as_int8(__builtin_ia32_compresssi256_mask((fh_v8si)refs, (fh_v8si)(int8)(0), lanes)), 0,
+            stack_ref + *sp);
+    *sp += (int)popcount((uint)lanes);
+  }
 #else
   ulong r[8];
   int c[8];
   vstore8(rays, 0, r);
   vstore8(refs, 0, c);
-  _Pragma("unroll") for (int i = 0; i < 8; ++i) {
-    stack_ref[*sp] = c[i];
-    stack_rays[*sp] = r[i];
-    *sp += r[i] != 0ul;
+  for (int k = 0; k < 2; ++k) {
+    _Pragma("unroll") for (int i = 0; i < 8; ++i) {
+      stack_ref[*sp] = c[i];
+      stack_rays[*sp] = r[i];
+      *sp += (int)((kinds[k] >> i) & 1u);
+    }
   }
 #endif
 }
@@ -118,8 +126,9 @@ FH_INLINE ulong find_occluders(__global const Bvh8Node* nodes, __global const Tr
         const int8 hits = ~(t_near > t_far);
         child_rays |= select((ulong8)(0ul), (ulong8)(1ul << l), convert_long8(hits));
       }
-      child_rays = select((ulong8)(0ul), child_rays, convert_long8(vload8(0, node->child) != (int8)(0)));
-      push_children(child_rays, vload8(0, node->child), stack_ref, stack_rays, &sp);
+      const int8 child = vload8(0, node->child);
+      child_rays = select((ulong8)(0ul), child_rays, convert_long8(child != (int8)(0)));
+      push_children(child_rays, child, stack_ref, stack_rays, &sp);
     } else {
       __global const TriangleBlock8* block = blocks + ~ref;
       for (ulong m = rays; m != 0ul; m &= m - 1ul) {
