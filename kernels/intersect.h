@@ -303,21 +303,27 @@ FH_INLINE WatertightLanes watertight_lanes(float8 x0, float8 y0, float8 z0, floa
   return e;
 }
 
+// watertight_lanes for one ray and the eight triangles of a leaf, their vertices read in
+// the ray's axis order.
+FH_INLINE WatertightLanes watertight_block(const RayPrecomp* r, __global const TriangleBlock8* block, float t_min,
+                                           float t_max) {
+  __global const float* v0 = block->v[0][0];
+  __global const float* v1 = block->v[1][0];
+  __global const float* v2 = block->v[2][0];
+  const int kx = 8 * r->kx, ky = 8 * r->ky, kz = 8 * r->kz;
+  return watertight_lanes(vload8(0, v0 + kx), vload8(0, v0 + ky), vload8(0, v0 + kz), vload8(0, v1 + kx),
+                          vload8(0, v1 + ky), vload8(0, v1 + kz), vload8(0, v2 + kx), vload8(0, v2 + ky),
+                          vload8(0, v2 + kz), (float8)(r->ox), (float8)(r->oy), (float8)(r->oz), (float8)(r->sx),
+                          (float8)(r->sy), (float8)(r->sz), (float8)(t_min), (float8)(t_max));
+}
+
 // The watertight test on the eight triangles of a leaf at once. Returns the lane of the
 // closest hit in [t_min, *t_max) that beats the current one (`best`, see closer_hit8),
 // updating *t_max and the barycentrics b1, b2 of v1 and v2, or -1. An any-hit query takes
 // the lowest lane hit and updates nothing.
 FH_INLINE int intersect_block(const RayPrecomp* r, __global const TriangleBlock8* block, float t_min, float* t_max,
                               int best, float* b1, float* b2, bool any_hit) {
-  __global const float* v0 = block->v[0][0];
-  __global const float* v1 = block->v[1][0];
-  __global const float* v2 = block->v[2][0];
-  const int kx = 8 * r->kx, ky = 8 * r->ky, kz = 8 * r->kz;
-  const WatertightLanes e = watertight_lanes(
-      vload8(0, v0 + kx), vload8(0, v0 + ky), vload8(0, v0 + kz), vload8(0, v1 + kx), vload8(0, v1 + ky),
-      vload8(0, v1 + kz), vload8(0, v2 + kx), vload8(0, v2 + ky), vload8(0, v2 + kz), (float8)(r->ox),
-      (float8)(r->oy), (float8)(r->oz), (float8)(r->sx), (float8)(r->sy), (float8)(r->sz), (float8)(t_min),
-      (float8)(*t_max));
+  const WatertightLanes e = watertight_block(r, block, t_min, *t_max);
   const int8 maybe = e.maybe;
   if (!any_lane(maybe)) return -1;
   // The division-free test rounds differently from the quotient below: a lane can pass it

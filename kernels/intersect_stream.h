@@ -41,15 +41,7 @@ FH_INLINE int lowest_bit64(ulong m) {
 // any-hit answer (which for a ray with no hit yet keeps the lanes with t_min <= t < t_max),
 // with one branch, on the division-free test, where intersect_block takes three.
 FH_INLINE bool block_occludes(const RayPrecomp* r, __global const TriangleBlock8* block, float t_min, float t_max) {
-  __global const float* v0 = block->v[0][0];
-  __global const float* v1 = block->v[1][0];
-  __global const float* v2 = block->v[2][0];
-  const int kx = 8 * r->kx, ky = 8 * r->ky, kz = 8 * r->kz;
-  const WatertightLanes e = watertight_lanes(
-      vload8(0, v0 + kx), vload8(0, v0 + ky), vload8(0, v0 + kz), vload8(0, v1 + kx), vload8(0, v1 + ky),
-      vload8(0, v1 + kz), vload8(0, v2 + kx), vload8(0, v2 + ky), vload8(0, v2 + kz), (float8)(r->ox),
-      (float8)(r->oy), (float8)(r->oz), (float8)(r->sx), (float8)(r->sy), (float8)(r->sz), (float8)(t_min),
-      (float8)(t_max));
+  const WatertightLanes e = watertight_block(r, block, t_min, t_max);
   if (!any_lane(e.maybe)) return false;
   const float8 t = e.t_scaled / e.det;
   return any_lane(e.maybe & (t >= (float8)(t_min)) & (t < (float8)(t_max)));
