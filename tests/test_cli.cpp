@@ -189,6 +189,27 @@ TEST(RenderCli, AnUnreadableTextureIsAWarningNamingItAndItsMaterial) {
   EXPECT_NE(r.output.find("broken.png"), std::string::npos) << r.output;
 }
 
+// A bench scene that cannot be read is refused before anything is measured: one line that
+// names it and what it needs, no rows, no --json file.
+TEST(BenchCli, AnUnreadableSceneIsOneLineBeforeAnyMeasurement) {
+  const std::string dir = test::tempDir("cli");
+  const std::pair<const char*, std::string> cases[] = {
+      {"cornell sponza", "bench scene 'sponza' needs " + dir + "/none/sponza/sponza.obj (set FREDHOLM_SCENES)"},
+      {"cornell bunnies-1m", "bench scene 'bunnies-1m' needs " + dir + "/none/bunny/CornellBox-Bunny.obj"},
+      {"cornell spheres:0", "bench scene 'spheres:0': spheres:N takes a triangle count from 1 to 1e8"},
+      {"cornell spnoza", "bench scene 'spnoza': no such scene (use cornell, bunny-box, sponza"},
+  };
+  for (const auto& [scenes, message] : cases) {
+    const auto r = test::runFredholm(std::string("bench ") + scenes + " --width 8 --height 8 --repeats 1 --json " +
+                                         dir + "/b.json",
+                                     "FREDHOLM_SCENES=" + dir + "/none");
+    EXPECT_EQ(r.exitCode, 1) << scenes << ": " << r.output;
+    EXPECT_NE(r.output.find("fredholm: error: " + message), std::string::npos) << scenes << ": " << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << scenes << ": " << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/b.json")) << scenes;
+  }
+}
+
 TEST(RenderCli, ProgressLinesWhenNotATerminal) {
   const std::string dir = test::tempDir("cli");
   const auto r = test::runFredholm("render --width 16 --height 16 --spp 8 -o " + dir + "/p.png");

@@ -283,6 +283,7 @@ int runBench(const BenchOptions& o) {
   if (o.repeats < 1 || o.width < 1 || o.height < 1) throw Error("--repeats/--width/--height must be positive");
   std::vector<std::string> scenes = o.scenes;
   if (scenes.empty()) scenes = {"cornell", "bunny-box", "sponza", "bunnies-1m"};
+  for (const std::string& spec : scenes) checkBenchScene(spec);
 
   const std::vector<DeviceInfo> devices = selectDevices(listDevices(), o.device);
   std::vector<std::unique_ptr<DeviceContext>> contexts;

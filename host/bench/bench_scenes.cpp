@@ -96,6 +96,24 @@ Scene sphereField(size_t count) {
   return scene;
 }
 
+// The shared scene file a named bench scene is read from (bunnies-1m places copies of the
+// bunny), or "" for one that is built in, generated or a path of the user's.
+std::string sharedFileOf(const std::string& spec) {
+  if (spec == "bunny-box" || spec == "bunnies-1m") return "bunny/CornellBox-Bunny.obj";
+  if (spec == "sponza") return "sponza/sponza.obj";
+  return "";
+}
+
+bool isSphereField(const std::string& spec) { return spec.rfind("spheres:", 0) == 0; }
+
+size_t sphereFieldTriangles(const std::string& spec) {
+  char* end = nullptr;
+  const double count = std::strtod(spec.c_str() + 8, &end);
+  if (end == spec.c_str() + 8 || *end || !(count >= 1) || count > 1e8)
+    throw Error("bench scene '" + spec + "': spheres:N takes a triangle count from 1 to 1e8 (e.g. spheres:1e6)");
+  return size_t(count);
+}
+
 }  // namespace
 
 // A scene without emitters (Sponza) gets a stand-in light so shadow rays can be timed: a
@@ -125,28 +143,29 @@ void addBenchLightIfNone(Scene& scene) {
   }
 }
 
-Scene benchScene(const std::string& spec, std::string& name) {
-  const std::string dir = sharedScenesDir();
-  auto shared = [&](const std::string& rel) {
-    const std::string path = dir + "/" + rel;
+void checkBenchScene(const std::string& spec) {
+  if (spec == "cornell") return;
+  if (isSphereField(spec)) {
+    sphereFieldTriangles(spec);
+    return;
+  }
+  if (const std::string rel = sharedFileOf(spec); !rel.empty()) {
+    const std::string path = sharedScenesDir() + "/" + rel;
     if (!fs::exists(path)) throw Error("bench scene '" + spec + "' needs " + path + " (set FREDHOLM_SCENES)");
-    return path;
-  };
+    return;
+  }
+  if (!fs::exists(spec))
+    throw Error("bench scene '" + spec + "': no such scene (use cornell, bunny-box, sponza, bunnies-1m, spheres:N or an OBJ path)");
+}
+
+Scene benchScene(const std::string& spec, std::string& name) {
+  checkBenchScene(spec);
   name = spec;
+  const std::string shared = sharedScenesDir() + "/" + sharedFileOf(spec);
   if (spec == "cornell") return loadDefaultScene();
-  if (spec == "bunny-box") return loadScene(shared("bunny/CornellBox-Bunny.obj"));
-  if (spec == "sponza") return loadScene(shared("sponza/sponza.obj"));
-  if (spec == "bunnies-1m") {
-    shared("bunny/CornellBox-Bunny.obj");
-    return bunnyCrowd(dir);
-  }
-  if (spec.rfind("spheres:", 0) == 0) {
-    char* end = nullptr;
-    const double count = std::strtod(spec.c_str() + 8, &end);
-    if (end == spec.c_str() + 8 || *end || !(count >= 1) || count > 1e8)
-      throw Error("bench scene '" + spec + "': spheres:N takes a triangle count from 1 to 1e8 (e.g. spheres:1e6)");
-    return sphereField(size_t(count));
-  }
+  if (spec == "bunny-box" || spec == "sponza") return loadScene(shared);
+  if (spec == "bunnies-1m") return bunnyCrowd(sharedScenesDir());
+  if (isSphereField(spec)) return sphereField(sphereFieldTriangles(spec));
   name = fs::path(spec).stem().string();
   return loadScene(spec);
 }

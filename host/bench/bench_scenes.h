@@ -10,6 +10,11 @@ namespace fh {
 // about 1.1M triangles) or an OBJ path; `name` is what the bench reports it as.
 Scene benchScene(const std::string& spec, std::string& name);
 
+// Throws the error benchScene would for a scene it cannot read (a shared scene that is not
+// there, a bad spheres:N, a path that does not exist) without loading anything, so a bench
+// can refuse before it measures.
+void checkBenchScene(const std::string& spec);
+
 // The directory of the shared test scenes: $FREDHOLM_SCENES, else ../shared/scenes
 // beside the source tree.
 std::string sharedScenesDir();
