@@ -161,9 +161,8 @@ void checkBenchScene(const std::string& spec) {
 Scene benchScene(const std::string& spec, std::string& name) {
   checkBenchScene(spec);
   name = spec;
-  const std::string shared = sharedScenesDir() + "/" + sharedFileOf(spec);
   if (spec == "cornell") return loadDefaultScene();
-  if (spec == "bunny-box" || spec == "sponza") return loadScene(shared);
+  if (spec == "bunny-box" || spec == "sponza") return loadScene(sharedScenesDir() + "/" + sharedFileOf(spec));
   if (spec == "bunnies-1m") return bunnyCrowd(sharedScenesDir());
   if (isSphereField(spec)) return sphereField(sphereFieldTriangles(spec));
   name = fs::path(spec).stem().string();
