@@ -14,6 +14,7 @@
 
 #include "accel/bvh.h"
 #include "base/atomic_file.h"
+#include "base/output_plan.h"
 #include "base/error.h"
 #include "base/vec.h"
 #include "bench/bench_scenes.h"
@@ -279,7 +280,9 @@ nlohmann::json sceneSummary(const std::string& name, const Scene& scene, const B
 
 // Every scene on every device --device selects, a row per scene, device and ray kind.
 int runBench(const BenchOptions& o) {
-  if (!o.jsonPath.empty()) checkOutputFile(o.jsonPath, o.force, "--json");
+  OutputPlan plan(o.force);
+  if (!o.jsonPath.empty()) plan.add(o.jsonPath, "--json");
+  plan.reserve();
   if (o.repeats < 1 || o.width < 1 || o.height < 1) throw Error("--repeats/--width/--height must be positive");
   std::vector<std::string> scenes = o.scenes;
   if (scenes.empty()) scenes = {"cornell", "bunny-box", "sponza", "bunnies-1m"};
@@ -299,6 +302,7 @@ int runBench(const BenchOptions& o) {
   for (const std::string& spec : scenes) {
     std::string name;
     Scene scene = benchScene(spec, name);
+    plan.checkAgainstInputs();
     addBenchLightIfNone(scene);
     const Bvh bvh = buildBvh(scene);
     nlohmann::json info = sceneSummary(name, scene, bvh);
@@ -320,8 +324,9 @@ int runBench(const BenchOptions& o) {
                           {"repeats", o.repeats},
                           {"scenes", sceneInfo},
                           {"records", records}};
-    writeTextAtomically(o.jsonPath, "--json", doc.dump(2) + "\n");
-    std::cout << "wrote " << o.jsonPath << "\n";
+    const std::string written = writeTextAtomically(o.jsonPath, "--json", doc.dump(2) + "\n");
+    plan.finish();
+    std::cout << "wrote " << written << "\n";
   }
   return 0;
 }

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "base/output_plan.h"
 #include "bench/bench_scenes.h"
 #include "cli/commands.h"
 #include "device/devices.h"
@@ -58,10 +59,15 @@ int runCompare(const CompareOptions& o) {
 }
 
 int runReference(const ReferenceOptions& o) {
-  checkOutputPath(o.output, o.force);
+  checkImageExtension(o.output, "-o");
   if (o.width <= 0 || o.height <= 0) throw Error("--width/--height must be positive");
-  writeImage(o.output, builtinReference(o.scene, o.width, o.height), {{"scene", o.scene}, {"method", "exact"}});
-  std::cout << "wrote " << o.output << "\n";
+  OutputPlan plan(o.force);
+  plan.add(o.output, "-o");
+  plan.reserve();
+  const std::string written =
+      writeImage(o.output, builtinReference(o.scene, o.width, o.height), {{"scene", o.scene}, {"method", "exact"}});
+  plan.finish();
+  std::cout << "wrote " << written << "\n";
   return 0;
 }
 

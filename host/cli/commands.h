@@ -28,7 +28,7 @@ struct RenderOptions {
   int rrDepth = RenderSettings{}.rrDepth;
   std::optional<size_t> wavefront;  // unset: chosen for each device
   bool allFeatures = false;
-  unsigned seed = 1;
+  std::string seed = "1";  // the sampler's 32-bit seed, checked by settingsFrom
   std::string cameraFile, eye, target, up;
   std::optional<float> fov;
   std::string aov;
@@ -37,7 +37,7 @@ struct RenderOptions {
   std::string passes, film;        // --passes A:B (a chunk), --film FILE (the film, for fredholm merge)
   // Under mpirun (host/distributed): the job this process is a rank of; null otherwise.
   const MpiSession* mpi = nullptr;
-  double checkpointEvery = RenderSettings{}.checkpointSeconds;
+  std::optional<double> checkpointEvery;  // unset: RenderSettings' default
   std::string device;
 };
 int runRender(RenderOptions o);

@@ -1,5 +1,6 @@
-// Ctrl-C and kill during a render: the first SIGINT or SIGTERM asks the render to stop
-// (it keeps the passes finished so far, which are written); a second SIGINT exits at once.
+// Ctrl-C, kill and a dropped terminal during a render: the first SIGINT, SIGTERM or SIGHUP
+// asks the render to stop (it keeps the passes finished so far, which are written); a second
+// SIGINT exits at once, removing the temporary files of writes in flight.
 #pragma once
 #include <atomic>
 

@@ -6,6 +6,7 @@
 
 #include "bench/bench.h"
 #include "cli/commands.h"
+#include "cli/parse_errors.h"
 #include "device/devices.h"
 #include "device/program.h"
 #ifdef FREDHOLM_HAVE_EMBREE
@@ -74,7 +75,7 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
       ->capture_default_str();
   rendering->add_flag("--all-features", o.allFeatures,
                       "Compile every material feature, not only the scene's (to measure specialization)");
-  rendering->add_option("--seed", o.seed, "Random seed")->capture_default_str();
+  rendering->add_option("--seed", o.seed, "Random seed, 0 to 4294967295")->capture_default_str();
   rendering->add_option("--camera", o.cameraFile, "Camera JSON {eye,target,up,fov_y_deg}");
   rendering->add_option("--eye", o.eye, "Camera position x,y,z");
   rendering->add_option("--target", o.target, "Point the camera looks at x,y,z");
@@ -88,7 +89,9 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
   rendering->add_option("--checkpoint", o.checkpoint,
                         "Save the render so far to FILE every --checkpoint-every seconds and when it ends "
                         "(also on Ctrl-C), to go on from with --resume");
-  rendering->add_option("--checkpoint-every", o.checkpointEvery, "Seconds between checkpoints")->capture_default_str();
+  rendering->add_option("--checkpoint-every", o.checkpointEvery,
+                        "Seconds between checkpoints (default " +
+                            std::to_string(int(RenderSettings{}.checkpointSeconds)) + ")");
   rendering->add_option("--resume", o.resume,
                         "Go on from a checkpoint of the same scene and settings (--spp may be raised): the image "
                         "is the one an uninterrupted render gives");
@@ -190,7 +193,7 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
-    std::cerr << "fredholm: error: " << e.what() << " (see fredholm " << (app.get_subcommands().empty() ? "" : app.get_subcommands().front()->get_name() + " ") << "--help)\n";
+    std::cerr << "fredholm: error: " << explainParseError(app, e, argc, argv) << "\n";
     return 1;
   }
 #ifdef FREDHOLM_HAVE_MPI

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "base/error.h"
+#include "base/output_plan.h"
 #include "cli/commands.h"
 #include "cli/flags.h"
 #include "image/image_io.h"
@@ -28,11 +29,15 @@ std::string missingPasses(const Film& film) {
 
 int runMerge(const MergeOptions& o) {
   const std::vector<std::string> layers = o.aovs.empty() ? std::vector<std::string>{} : parseAovLayers(o.aovs);
-  checkOutputPath(o.output, o.force);
+  checkImageExtension(o.output, "-o");
+  OutputPlan plan(o.force);
+  plan.add(o.output, "-o");
+  plan.reserve();
   if (!layers.empty() && extensionOf(o.output) != ".exr")
     throw Error("--aovs: layers are written into one EXR; -o '" + o.output + "' is not an .exr file");
   const SavedFilm merged = mergeFilms(o.parts, "", "merge");
   const Film& film = merged.film;
+  plan.checkAgainstInputs();
   for (const std::string& layer : layers)
     if (isSurfaceAov(layer) && !film.hasSurfaceAovs())
       throw Error("--aovs " + layer + ": the chunks were rendered without it (render them with --aovs " + layer + ")");
@@ -45,8 +50,9 @@ int runMerge(const MergeOptions& o) {
                                                  {"merged_parts", std::to_string(o.parts.size())},
                                                  {"fingerprint", merged.fingerprint}};
   if (!missing.empty()) metadata["missing_passes"] = missing;
-  writeImage(o.output, film.imageWithLayers(layers), metadata);
-  std::cout << "wrote " << o.output << " (" << film.passes() << " passes from " << o.parts.size() << " parts)\n";
+  const std::string written = writeImage(o.output, film.imageWithLayers(layers), metadata);
+  plan.finish();
+  std::cout << "wrote " << written << " (" << film.passes() << " passes from " << o.parts.size() << " parts)\n";
   return 0;
 }
 

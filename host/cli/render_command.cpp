@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "base/atomic_file.h"
+#include "base/output_plan.h"
 #include "base/vec.h"
 #include "cli/commands.h"
 #include "cli/flags.h"
@@ -104,6 +105,14 @@ void chunkOf(const RenderOptions& o, RenderSettings& s) {
   s.spp = int(end);
 }
 
+// --seed: the sampler's seed is 32 bits.
+unsigned parseSeed(const std::string& text) {
+  const bool digits = !text.empty() && text.size() <= 10 && text.find_first_not_of("0123456789") == std::string::npos;
+  if (!digits || std::stoull(text) > 0xFFFFFFFFull)
+    throw Error("--seed '" + text + "': expected a whole number from 0 to 4294967295");
+  return unsigned(std::stoull(text));
+}
+
 // Every flag that does not need the scene, checked; 64 spp by default (4 for --aov), or
 // with --time or --noise and no --spp as many as they take (a render numbers its samples in
 // 32 bits, so at most that many).
@@ -139,7 +148,7 @@ RenderSettings settingsFrom(const RenderOptions& o) {
   if (o.adaptive && !o.aov.empty()) throw Error("--adaptive samples a render's noise; --aov renders a debug view");
   s.maxDepth = o.maxDepth;
   s.rrDepth = o.rrDepth;
-  s.seed = o.seed;
+  s.seed = parseSeed(o.seed);
   s.wavefront = o.wavefront.value_or(0);
   s.allFeatures = o.allFeatures;
   s.progress = true;
@@ -183,30 +192,40 @@ void reportDevices(const RenderResult& r) {
 }
 
 // The --aovs layers, parsed and checked against the other flags and the output; picks the
-// default output name (PNG, or EXR with layers) and checks every output file before work.
-std::vector<std::string> checkOutputs(RenderOptions& o, RenderSettings& settings, int rank) {
+// default output name (PNG, or EXR with layers) and plans every file the render writes.
+std::vector<std::string> planOutputs(RenderOptions& o, RenderSettings& settings, int rank, OutputPlan& plan) {
   const std::vector<std::string> layers = o.aovs.empty() ? std::vector<std::string>{} : parseAovLayers(o.aovs);
   if (!o.aov.empty() && !layers.empty()) throw Error("--aov (a debug view) and --aovs (layers beside the image): pick one");
   for (const auto& layer : layers) settings.surfaceAovs |= isSurfaceAov(layer);
   // An explicit -o is never overwritten without --force; the default name steps aside.
   // With --film the film is the output, and an image is written only where -o asks.
-  if (o.output.empty() && o.film.empty()) o.output = firstFreeName(layers.empty() ? "fredholm.png" : "fredholm.exr");
+  const bool defaultName = o.output.empty() && o.film.empty();
+  if (defaultName) o.output = firstFreeName(layers.empty() ? "fredholm.png" : "fredholm.exr");
   if (!o.film.empty() && !o.aov.empty()) throw Error("--film saves a render's passes; --aov renders none");
-  if (!std::isfinite(o.checkpointEvery) || o.checkpointEvery < 0)
+  const double every = o.checkpointEvery.value_or(settings.checkpointSeconds);
+  if (!std::isfinite(every) || every < 0)
     throw Error("--checkpoint-every must be a finite number of seconds, 0 or more");
-  settings.checkpointSeconds = o.checkpointEvery;
+  if (o.checkpointEvery && o.checkpoint.empty())
+    throw Error("--checkpoint-every sets how often --checkpoint saves, and no --checkpoint FILE is given");
+  settings.checkpointSeconds = every;
   // Under mpirun every rank saves its own film, FILE.rank<r>. The checkpoint a render
   // resumes from is its own to overwrite.
   if (!o.checkpoint.empty()) {
     settings.checkpointPath = o.mpi ? rankCheckpointPath(o.checkpoint, rank) : o.checkpoint;
-    if (o.checkpoint != o.resume) checkOutputFile(settings.checkpointPath, o.force, "--checkpoint");
+    plan.add(settings.checkpointPath, "--checkpoint", OutputKind::Owned,
+             o.checkpoint == o.resume ? settings.checkpointPath : "");
   }
-  if (rank != 0) return layers;  // rank 0 writes the image and the rest
-  if (!o.film.empty()) checkOutputFile(o.film, o.force, "--film");
-  if (!o.output.empty()) checkOutputPath(o.output, o.force);
-  if (!layers.empty() && !o.output.empty() && extensionOf(o.output) != ".exr")
-    throw Error("--aovs: layers are written into one EXR; -o '" + o.output + "' is not an .exr file");
-  if (!o.statsFile.empty()) checkOutputFile(o.statsFile, o.force, "--stats");
+  if (rank == 0) {  // rank 0 writes the image and the rest
+    if (!o.film.empty()) plan.add(o.film, "--film");
+    if (!o.output.empty()) {
+      checkImageExtension(o.output, "-o");
+      plan.add(o.output, "-o", defaultName ? OutputKind::Default : OutputKind::Named);
+    }
+    if (!layers.empty() && !o.output.empty() && extensionOf(o.output) != ".exr")
+      throw Error("--aovs: layers are written into one EXR; -o '" + o.output + "' is not an .exr file");
+    if (!o.statsFile.empty()) plan.add(o.statsFile, "--stats");
+  }
+  plan.reserve();
   return layers;
 }
 
@@ -258,14 +277,10 @@ RenderResult renderOnEveryRank(const RenderOptions& o, const std::vector<DeviceI
 std::string writeOutputs(const RenderOptions& o, const RenderSettings& s, const Film& film, const Image& image,
                          const std::map<std::string, std::string>& metadata) {
   std::string written;
-  if (!o.output.empty()) {
-    writeImage(o.output, image, metadata);
-    written = o.output;
-  }
-  if (!o.film.empty() && film.passes() > 0) {
-    saveFilm(o.film, film, s.fingerprint, "--film");
-    written += (written.empty() ? "" : " and ") + o.film + " (passes " + film.describePasses() + ")";
-  }
+  if (!o.output.empty()) written = writeImage(o.output, image, metadata);
+  if (!o.film.empty() && film.passes() > 0)
+    written += (written.empty() ? "" : " and ") + saveFilm(o.film, film, s.fingerprint, "--film") + " (passes " +
+               film.describePasses() + ")";
   return written;
 }
 
@@ -275,7 +290,7 @@ std::map<std::string, std::string> imageMetadata(const RenderOptions& o, const S
                                                  double estimatedRelMse) {
   std::map<std::string, std::string> metadata = {
       {"scene", scene.sourcePath},       {"spp", formatSeconds(spp)},          {"method", method},
-      {"device", r.stats.contributors()}, {"seed", std::to_string(o.seed)},     {"seconds", formatSeconds(seconds)},
+      {"device", r.stats.contributors()}, {"seed", o.seed},     {"seconds", formatSeconds(seconds)},
       {"filter", o.filter},              {"max_depth", std::to_string(o.maxDepth)}};
   if (!o.aovs.empty()) metadata["aovs"] = o.aovs;
   if (!o.envMap.empty()) {
@@ -283,7 +298,8 @@ std::map<std::string, std::string> imageMetadata(const RenderOptions& o, const S
     metadata["env_rotate"] = formatSeconds(o.envRotate.value_or(0.f));
     metadata["env_scale"] = formatScientific(o.envScale.value_or(1.f));
   }
-  if (o.aov.empty()) metadata["estimated_relmse"] = formatScientific(estimatedRelMse);
+  // The estimate compares a pixel's samples with each other: with one sample there is none.
+  if (o.aov.empty() && r.film.passes() >= 2) metadata["estimated_relmse"] = formatScientific(estimatedRelMse);
   return metadata;
 }
 
@@ -311,7 +327,8 @@ int runRender(RenderOptions o) {
   const Aov aov = debugView ? parseAov(o.aov) : Aov::Albedo;
   const int rank = mpiRank(o);
   if (o.mpi) checkSharedRender(o, settings, rank);
-  const std::vector<std::string> layers = checkOutputs(o, settings, rank);
+  OutputPlan plan(o.force);
+  const std::vector<std::string> layers = planOutputs(o, settings, rank, plan);
   const auto devices = selectDevices(listDevices(), o.device);
   if (debugView && devices.size() > 1)
     throw Error("--aov renders on one device, and --device '" + o.device + "' selects " +
@@ -327,6 +344,7 @@ int runRender(RenderOptions o) {
     settings.resume = o.mpi ? resumeRanks(o, rank, settings.fingerprint)
                             : std::make_shared<Film>(loadCheckpoint(o.resume, settings.fingerprint, "--resume"));
   }
+  plan.checkAgainstInputs();
   const auto start = std::chrono::steady_clock::now();
   const Bvh bvh = buildBvh(scene);
   const RenderResult r = debugView ? renderDebugView(aov, devices, scene, bvh, camera, settings)
@@ -363,6 +381,7 @@ int runRender(RenderOptions o) {
   }
   const std::string written = writeOutputs(o, settings, r.film, image, metadata);
   printSummary(o, settings, scene, r, method, spp, seconds, estimatedRelMse);
+  plan.finish();
   std::cout << "wrote " << written << "\n";
   return 0;
 }

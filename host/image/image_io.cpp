@@ -76,6 +76,12 @@ float linearToSrgb(float x) {
 float srgbToLinear(float x) { return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f); }
 
 ImageEncoding checkOutputPath(const std::string& path, bool force, const std::string& flag) {
+  const ImageEncoding encoding = checkImageExtension(path, flag);
+  checkOutputFile(path, force, flag);
+  return encoding;
+}
+
+ImageEncoding checkImageExtension(const std::string& path, const std::string& flag) {
   const std::string ext = extensionOf(path);
   ImageEncoding encoding;
 #ifndef FREDHOLM_HAVE_OIIO
@@ -87,7 +93,6 @@ ImageEncoding checkOutputPath(const std::string& path, bool force, const std::st
   else
     throw Error(flag + " '" + path + "': unknown image extension '" + ext +
                 "' (use .exr, .hdr, .pfm, .png or .jpg)");
-  checkOutputFile(path, force, flag);
   return encoding;
 }
 
@@ -199,9 +204,10 @@ void checkComplete(const std::string& path, const Image& image) {
 
 }  // namespace
 
-void writeImage(const std::string& path, const Image& image, const std::map<std::string, std::string>& metadata) {
-  const ImageEncoding encoding = checkOutputPath(path, true);
-  writeAtomically(
+std::string writeImage(const std::string& path, const Image& image,
+                       const std::map<std::string, std::string>& metadata) {
+  const ImageEncoding encoding = checkImageExtension(path, "-o");
+  return writeAtomically(
       path, "image", [&](const std::string& temp) { encodeImage(temp, image, encoding, metadata); },
       [&](const std::string& temp) { checkComplete(temp, image); });
 }

@@ -24,6 +24,10 @@ struct Image {
 
 enum class ImageEncoding { LinearFloat, Srgb8 };
 
+// The encoding the path's extension asks for; throws fh::Error naming the flag for an
+// unknown extension.
+ImageEncoding checkImageExtension(const std::string& path, const std::string& flag);
+
 // Throws fh::Error (naming the flag) for an unknown extension, a missing or unwritable
 // directory, or an existing file without `force`. Call before rendering.
 ImageEncoding checkOutputPath(const std::string& path, bool force, const std::string& flag = "-o");
@@ -38,7 +42,8 @@ std::string extensionOf(const std::string& path);
 // The first of base.ext, base-1.ext, base-2.ext ... that does not exist.
 std::string firstFreeName(const std::string& path);
 
-void writeImage(const std::string& path, const Image& image, const std::map<std::string, std::string>& metadata);
+// Writes the image whole or not at all (base/atomic_file.h); returns the path written.
+std::string writeImage(const std::string& path, const Image& image, const std::map<std::string, std::string>& metadata);
 
 Image readImage(const std::string& path);  // linear float RGB (tests)
 

@@ -76,7 +76,7 @@ std::string renderFingerprint(const Scene& scene, const Camera& camera, const Re
   return f.hex();
 }
 
-void saveFilm(const std::string& path, const Film& film, const std::string& fingerprint, const std::string& flag) {
+std::string saveFilm(const std::string& path, const Film& film, const std::string& fingerprint, const std::string& flag) {
   std::ostringstream out;
   out << kMagic << ' ' << fingerprint << ' ' << film.width << ' ' << film.height << ' ' << film.passRanges().size();
   for (const auto& [begin, end] : film.passRanges()) out << ' ' << begin << ' ' << end;
@@ -87,7 +87,7 @@ void saveFilm(const std::string& path, const Film& film, const std::string& fing
     out.write(reinterpret_cast<const char*>(v->data()), std::streamsize(v->size() * 8));
   for (const auto& list : {film.roundPixels, film.nextRoundPixels})
     if (list) out.write(reinterpret_cast<const char*>(list->data()), std::streamsize(list->size() * 4));
-  writeTextAtomically(path, flag, out.str());
+  return writeTextAtomically(path, flag, out.str());
 }
 
 void saveCheckpoint(const std::string& path, const Film& film, const std::string& fingerprint) {

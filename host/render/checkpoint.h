@@ -22,7 +22,8 @@ std::string renderFingerprint(const Scene& scene, const Camera& camera, const Re
 
 // Writes the film with the render's fingerprint, atomically (a temporary file renamed over
 // `path`); errors name `flag`. The same format serves checkpoints and chunks (--film).
-void saveFilm(const std::string& path, const Film& film, const std::string& fingerprint, const std::string& flag);
+// Returns the path written (base/atomic_file.h).
+std::string saveFilm(const std::string& path, const Film& film, const std::string& fingerprint, const std::string& flag);
 void saveCheckpoint(const std::string& path, const Film& film, const std::string& fingerprint);
 
 // A film file as saved: the film (its first pass and pass count included) and the

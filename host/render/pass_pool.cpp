@@ -33,7 +33,7 @@ PassPool::PassPool(const RenderSettings& s, int workers)
       progress_(s.progress),
       lastCheckpoint_(std::chrono::steady_clock::now()) {
   // A resumed render goes on from the first pass its film lacks; a chunk starts at its first.
-  next_ = nextToMerge_ = uint32_t(film_.nextPass());
+  next_ = nextToMerge_ = firstNew_ = uint32_t(film_.nextPass());
   mergedSamples_ = film_.samples();
   samplesDone_.assign(size_t(workers), 0);
   if (!s.adaptive) {
@@ -117,7 +117,9 @@ PassPool::NewPass PassPool::nextNewPass(uint32_t& pass) {
     ledgerDry_ = true;  // ask no more: for another process, each question is a message
     return NewPass::None;
   }
-  if (next_ >= total_ || outOfTime()) return NewPass::None;
+  // However short the time budget, a render renders one pass: an image of nothing would
+  // answer no one's question.
+  if (next_ >= total_ || (next_ > firstNew_ && outOfTime())) return NewPass::None;
   const Round* round = roundOf(next_);
   if (!round) return NewPass::Later;
   if (settings_.adaptive) {

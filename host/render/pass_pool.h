@@ -79,6 +79,7 @@ class PassPool : public PassSource {
   std::chrono::steady_clock::time_point start_;  // when the first pass was handed out
   bool started_ = false;
   uint32_t next_ = 0, nextToMerge_ = 0;
+  uint32_t firstNew_ = 0;  // the first pass this render hands out (a time budget allows it always)
   double mergedSamples_ = 0;  // in the film: what the progress display counts
   // The rounds whose pixels are known, in order, from the one being merged on.
   std::deque<Round> rounds_;
