@@ -4,13 +4,17 @@
 #include "accel/bvh.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <future>
+#include <limits>
+#include <string>
 #include <thread>
 
+#include "base/error.h"
 #include "base/vec.h"
 
 namespace fh {
@@ -53,9 +57,18 @@ constexpr float kVolumeWeight = 1.0f;
 constexpr float kRoomyVolume = 1e-2f;
 constexpr unsigned kRoomyLeaf = 2;
 
+// Any finite scene must build, from triangles a few 1e-38 wide to coordinates near FLT_MAX,
+// so what the builder derives from the floats it is given (extents, areas, volumes,
+// centroids, bin indices and planes, SAH costs) is computed in double, which holds every
+// such value of float inputs without overflow or underflow: a float extent overflows to inf
+// past FLT_MAX, an area past 1.8e19 and underflows below 1e-19, a centroid's sum lo + hi
+// overflows past FLT_MAX / 2. The boxes themselves stay float (the kernels read them), each
+// the exact bound of floats or rounded outwards (edgeCrossing).
+constexpr double kMinArea = std::numeric_limits<double>::min();  // floor of a parent's area (a point's is 0)
+
 // Grown with plain comparisons (std::min/max), which compile inline: fminf/fmaxf, which
-// must handle NaNs (scenes have none: the loader rejects them), were library calls on
-// the build's hot path.
+// must handle NaNs (scenes have none: the loader rejects them, buildBvh checks), were
+// library calls on the build's hot path.
 struct Box {
   float3 lo{INFINITY, INFINITY, INFINITY};
   float3 hi{-INFINITY, -INFINITY, -INFINITY};
@@ -68,17 +81,16 @@ struct Box {
     }
   }
   bool empty() const { return lo[0] > hi[0] || lo[1] > hi[1] || lo[2] > hi[2]; }
-  float area() const {
-    if (empty()) return 0.f;
-    const float3 e = hi - lo;
-    return 2.f * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]);
+  double extent(size_t axis) const { return double(hi[axis]) - double(lo[axis]); }
+  double area() const {
+    if (empty()) return 0.0;
+    const double x = extent(0), y = extent(1), z = extent(2);
+    return 2.0 * (x * y + y * z + z * x);
   }
-  float volume() const {
-    if (empty()) return 0.f;
-    const float3 e = hi - lo;
-    return e[0] * e[1] * e[2];
+  double volume() const {
+    if (empty()) return 0.0;
+    return extent(0) * extent(1) * extent(2);
   }
-  float3 centroid() const { return (lo + hi) * 0.5f; }
   static Box overlap(const Box& a, const Box& b) {
     Box o;
     for (size_t k = 0; k < 3; ++k) {
@@ -117,6 +129,38 @@ struct BinaryTree {
   std::vector<unsigned> leafTriangles;
 };
 
+// The references' centroids' bounds, and the object split's bins over them. In double, and
+// as twice the centroid, lo + hi, which cannot overflow (float's lo + hi did past FLT_MAX /
+// 2): a centroid's bin along an axis is (sum - lo) * scale, at most kBins - 1. The scale is
+// finite for any two distinct centroids (1e-45 apart or 7e38), and the index a finite
+// number in [0, kBins (1 + 2^-50)]: float's kBins / extent was inf over denormal extents,
+// (c - lo) inf over the float range, and int(inf) or int(NaN) indexed the bins out of
+// bounds. The partition uses the very same index as the binning, so a split's children hold
+// exactly the references its cost counted, neither side empty.
+struct CentroidBins {
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  double scale[3] = {};  // 0 where every centroid is the same along the axis
+
+  static double sum(const Box& b, size_t axis) { return double(b.lo[axis]) + double(b.hi[axis]); }
+  void grow(const Box& b) {
+    for (size_t a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], sum(b, a));
+      hi[a] = std::max(hi[a], sum(b, a));
+    }
+  }
+  // Once every reference has grown the bounds.
+  void setScale() {
+    for (size_t a = 0; a < 3; ++a) {
+      const double extent = hi[a] - lo[a];
+      scale[a] = extent > 0.0 ? double(kBins) / extent : 0.0;
+    }
+  }
+  // sum - lo >= 0: lo is the least of the very same sums, and rounding is monotonic.
+  int bin(const Box& b, size_t axis) const {
+    return int(std::min((sum(b, axis) - lo[axis]) * scale[axis], double(kBins - 1)));
+  }
+};
+
 // A reference per triangle, with the triangle's box, and the triangles' corners side by
 // side (three per triangle, for clipping), on `threads` threads.
 std::vector<Reference> triangleReferences(const Scene& scene, unsigned threads, std::vector<float3>& corners) {
@@ -139,13 +183,45 @@ std::vector<Reference> triangleReferences(const Scene& scene, unsigned threads, 
   return refs;
 }
 
+// The box of the point where the edge pq crosses the plane x[a] = position, rounded
+// outwards: widened before its rounding to float by more than the error of computing it in
+// T and of that rounding together. In float (edges whose coordinates are at most 2^125,
+// so that nothing overflows), by 2^-20 of the edge's magnitude M along each axis and 2^-147:
+// the interpolation errs by less than 12 2^-24 M + 2^-149 (denormal results round
+// absolutely), the rounding by 2^-24 M + 2^-150. In double (any finite edge: in float,
+// q - p overflows across the float range, and the point was then NaN), by 2^-22 M and
+// 2^-149, against a few 2^-53 M and the same rounding. Branch-free (a directed rounding's
+// compare and step cost a tenth of the build).
+template <typename T>
+void edgeCrossing(const float3& p, const float3& q, size_t a, float position, float3& lo, float3& hi) {
+  constexpr bool single = sizeof(T) == sizeof(float);
+  const T relative = single ? T(0x1p-20) : T(0x1p-22), absolute = single ? T(0x1p-147) : T(0x1p-149);
+  const T s = (T(position) - T(p[a])) / (T(q[a]) - T(p[a]));
+  for (size_t c = 0; c < 3; ++c) {
+    const T x = T(p[c]) + (T(q[c]) - T(p[c])) * s,
+            slack = std::max(std::fabs(T(p[c])), std::fabs(T(q[c]))) * relative + absolute;
+    if constexpr (single) {
+      lo[c] = x - slack;
+      hi[c] = x + slack;
+    } else {
+      lo[c] = float(std::max(x - slack, -double(FLT_MAX)));
+      hi[c] = float(std::min(x + slack, double(FLT_MAX)));
+    }
+  }
+  lo[a] = hi[a] = position;
+}
+
 // The boxes of a reference's triangle piece on either side of the plane x[axis] = position
 // (either may be empty). The crossing points of edges with the plane are widened by the
-// rounding of their interpolation, so the boxes stay conservative and no ray slips between
-// the two.
+// rounding of their interpolation (edgeCrossing), so the boxes stay conservative and no ray
+// slips between the two, denormal coordinates and coordinates near FLT_MAX included.
 std::pair<Box, Box> splitReference(const float3* corners, const Reference& ref, int axis, float position) {
   const size_t a = size_t(axis);
   const float3* v = corners + 3 * size_t(ref.triangle);
+  float magnitude = 0.f;
+  for (size_t k = 0; k < 3; ++k)
+    for (size_t c = 0; c < 3; ++c) magnitude = std::max(magnitude, std::fabs(v[k][c]));
+  const bool inFloat = magnitude <= 0x1p125f;
   Box left, right;
   for (size_t k = 0; k < 3; ++k) {
     const float3& p = v[k];
@@ -153,14 +229,11 @@ std::pair<Box, Box> splitReference(const float3* corners, const Reference& ref, 
     if (p[a] <= position) left.grow(p);
     if (p[a] >= position) right.grow(p);
     if ((p[a] < position && q[a] > position) || (p[a] > position && q[a] < position)) {
-      const float s = (position - p[a]) / (q[a] - p[a]);
       float3 lo, hi;
-      for (size_t c = 0; c < 3; ++c) {
-        const float x = p[c] + (q[c] - p[c]) * s, slack = std::max(std::fabs(p[c]), std::fabs(q[c])) * 0x1p-20f;
-        lo[c] = x - slack;
-        hi[c] = x + slack;
-      }
-      lo[a] = hi[a] = position;
+      if (inFloat)
+        edgeCrossing<float>(p, q, a, position, lo, hi);
+      else
+        edgeCrossing<double>(p, q, a, position, lo, hi);
       left.grow(lo, hi);
       right.grow(lo, hi);
     }
@@ -182,7 +255,7 @@ constexpr unsigned kParallelTriangles = 16384;
 // budget, too, does not depend on the order subtrees are built in.
 class BinaryBuilder {
  public:
-  BinaryBuilder(const float3* corners, float rootArea, float rootVolume, int parallelDepth)
+  BinaryBuilder(const float3* corners, double rootArea, double rootVolume, int parallelDepth)
       : corners_(corners), rootArea_(rootArea), rootVolume_(rootVolume), parallelDepth_(parallelDepth) {}
 
   BinaryTree build(References refs, size_t room, int depth = 0) {
@@ -196,8 +269,9 @@ class BinaryBuilder {
  private:
   struct Split {
     int axis = -1;
-    float position = 0.f;
-    float cost = INFINITY;
+    int bin = -1;  // the last bin on the left
+    float position = 0.f;  // a spatial split's plane
+    double cost = INFINITY;
     bool spatial = false;
     Box left, right;  // the children's boxes
     size_t leftCount = 0, rightCount = 0;
@@ -209,51 +283,48 @@ class BinaryBuilder {
   // collapsed. Whole blocks of eight would be the leaf test's true cost, but they make the
   // builder stop at bigger, looser leaves that the wide collapse can no longer split
   // (bench/RESULTS.md: the Cornell box's tree got worse).
-  static float groupedCount(size_t n) { return float((n + kCountGroup - 1) / kCountGroup * kCountGroup); }
+  static double groupedCount(size_t n) { return double((n + kCountGroup - 1) / kCountGroup * kCountGroup); }
 
-  float cost(const Box& left, size_t nLeft, const Box& right, size_t nRight, float parentArea) const {
-    return kTraversalCost +
-           kTriangleCost * (left.area() * groupedCount(nLeft) + right.area() * groupedCount(nRight)) / parentArea;
+  // Finite for any finite boxes: areas in double, the parent's area > 0 and at least the
+  // children's. perArea: kTriangleCost over the parent's area (a division per plane was a
+  // tenth of the object splits' time).
+  static double cost(const Box& left, size_t nLeft, const Box& right, size_t nRight, double perArea) {
+    return kTraversalCost + (left.area() * groupedCount(nLeft) + right.area() * groupedCount(nRight)) * perArea;
   }
 
   // Binned over the references' centroids, all three axes in one pass over them.
-  Split objectSplit(References refs, const Box& centroidBox, float parentArea) const {
+  Split objectSplit(References refs, const CentroidBins& centroids, double parentArea) const {
     Box bins[3][kBins];
     size_t counts[3][kBins] = {};
-    float scale[3];
-    for (size_t a = 0; a < 3; ++a) {
-      const float extent = centroidBox.hi[a] - centroidBox.lo[a];
-      scale[a] = extent > 0.f ? kBins / extent : 0.f;
-    }
     for (const Reference& r : refs) {
-      const float3 c = r.box.centroid();
       for (size_t a = 0; a < 3; ++a) {
-        const int b = std::min(kBins - 1, int((c[a] - centroidBox.lo[a]) * scale[a]));
+        const int b = centroids.bin(r.box, a);
         bins[a][b].grow(r.box);
         ++counts[a][b];
       }
     }
     Split best;
     for (int axis = 0; axis < 3; ++axis) {
-      const float lo = centroidBox.lo[size_t(axis)], binScale = scale[axis];
-      if (binScale == 0.f) continue;
-      sweep(bins[axis], counts[axis], counts[axis], kBins, parentArea,
-            [&](int b) { return lo + float(b + 1) / binScale; }, axis, false, best);
+      if (centroids.scale[axis] == 0.0) continue;
+      sweep(bins[axis], counts[axis], counts[axis], kBins, parentArea, [](int) { return 0.f; }, axis, false, best);
     }
     return best;
   }
 
   // Binned over the node's box: each reference is cut at the bin planes it spans, its pieces
   // grow the bins, and it enters the bin of its lowest piece and leaves by its highest.
-  Split spatialSplit(References refs, const Box& box, float parentArea) const {
+  // The bins' planes are placed in double and rounded to floats, which lie in the box
+  // (float's extent overflowed to inf, and its width underflowed to 0 over denormal
+  // extents); a plane rounded onto a neighbour's or the box's face only leaves a bin empty.
+  Split spatialSplit(References refs, const Box& box, double parentArea) const {
     Split best;
     for (int axis = 0; axis < 3; ++axis) {
       const size_t a = size_t(axis);
-      const float lo = box.lo[a], extent = box.hi[a] - lo;
-      if (!(extent > 0.f)) continue;
-      const float width = extent / kSpatialBins;
-      auto plane = [&](int b) { return lo + float(b + 1) * width; };
-      auto binOf = [&](float x) { return std::clamp(int((x - lo) / width), 0, kSpatialBins - 1); };
+      const double lo = box.lo[a], extent = box.extent(a);
+      if (!(extent > 0.0)) continue;
+      const double width = extent / kSpatialBins;
+      auto plane = [&](int b) { return float(lo + double(b + 1) * width); };
+      auto binOf = [&](float x) { return int(std::clamp((double(x) - lo) / width, 0.0, double(kSpatialBins - 1))); };
       Box bins[kSpatialBins];
       size_t enter[kSpatialBins] = {}, leave[kSpatialBins] = {};
       for (const Reference& r : refs) {
@@ -276,7 +347,7 @@ class BinaryBuilder {
   // The SAH cost of each plane between bins: the left side counts the references that
   // enter its bins, the right side those that leave by its bins.
   template <typename Plane>
-  void sweep(const Box* bins, const size_t* enter, const size_t* leave, int n, float parentArea, Plane plane,
+  void sweep(const Box* bins, const size_t* enter, const size_t* leave, int n, double parentArea, Plane plane,
              int axis, bool spatial, Split& best) const {
     Box rightBox[kMaxBins + 1];
     size_t rightCount[kMaxBins + 1] = {};
@@ -285,6 +356,7 @@ class BinaryBuilder {
       rightBox[size_t(b)].grow(bins[b]);
       rightCount[size_t(b)] = rightCount[size_t(b) + 1] + leave[b];
     }
+    const double perArea = kTriangleCost / parentArea;
     Box left;
     size_t leftCount = 0;
     for (int b = 0; b < n - 1; ++b) {
@@ -292,8 +364,8 @@ class BinaryBuilder {
       leftCount += enter[b];
       const size_t right = rightCount[size_t(b) + 1];
       if (leftCount == 0 || right == 0) continue;
-      const float c = cost(left, leftCount, rightBox[size_t(b) + 1], right, parentArea);
-      if (c < best.cost) best = {axis, plane(b), c, spatial, left, rightBox[size_t(b) + 1], leftCount, right};
+      const double c = cost(left, leftCount, rightBox[size_t(b) + 1], right, perArea);
+      if (c < best.cost) best = {axis, b, plane(b), c, spatial, left, rightBox[size_t(b) + 1], leftCount, right};
     }
   }
 
@@ -309,8 +381,8 @@ class BinaryBuilder {
   void partitionSpatial(References refs, const Split& s, std::vector<Reference>& left,
                         std::vector<Reference>& right) const {
     const size_t a = size_t(s.axis);
-    const float nl = float(s.leftCount), nr = float(s.rightCount);
-    const float splitCost = s.left.area() * nl + s.right.area() * nr;
+    const double nl = double(s.leftCount), nr = double(s.rightCount);
+    const double splitCost = s.left.area() * nl + s.right.area() * nr;
     for (const Reference& r : refs) {
       if (r.box.hi[a] <= s.position) {
         left.push_back(r);
@@ -320,10 +392,14 @@ class BinaryBuilder {
         Box grownLeft = s.left, grownRight = s.right;
         grownLeft.grow(r.box);
         grownRight.grow(r.box);
-        const float wholeLeft = grownLeft.area() * nl + s.right.area() * (nr - 1.f);
-        const float wholeRight = s.left.area() * (nl - 1.f) + grownRight.area() * nr;
+        const double wholeLeft = grownLeft.area() * nl + s.right.area() * (nr - 1.0);
+        const double wholeRight = s.left.area() * (nl - 1.0) + grownRight.area() * nr;
         const auto [lo, hi] = splitReference(corners_, r, s.axis, s.position);
-        if (lo.empty()) {
+        if (lo.empty() && hi.empty()) {
+          // Clipping found no piece on either side (a piece's box may be wider than its
+          // piece): the reference stays whole, which is conservative.
+          (wholeLeft <= wholeRight ? left : right).push_back(r);
+        } else if (lo.empty()) {
           right.push_back({hi, r.triangle});
         } else if (hi.empty()) {
           left.push_back({lo, r.triangle});
@@ -340,26 +416,28 @@ class BinaryBuilder {
   }
 
   void split(int node, References refs, size_t room, int depth) {
-    Box box, centroidBox;
+    Box box;
+    CentroidBins centroids;
     for (const Reference& r : refs) {
       box.grow(r.box);
-      centroidBox.grow(r.box.centroid());
+      centroids.grow(r.box);
     }
+    centroids.setScale();
     tree_.nodes[size_t(node)].box = box;
     const size_t count = refs.size();
     if (count == 1) return makeLeaf(node, refs);
 
-    const float area = std::max(box.area(), 1e-30f);
-    const Split object = objectSplit(refs, centroidBox, area);
+    const double area = std::max(box.area(), kMinArea);
+    const Split object = objectSplit(refs, centroids, area);
     Split s = object;
     if (room > 0 && s.axis >= 0 && Box::overlap(s.left, s.right).area() > kOverlapToTrySpatial * rootArea_) {
       const Split spatial = spatialSplit(refs, box, area);
       // Only within the budget: a spatial split adds at most the references it cuts.
       const size_t added = spatial.leftCount + spatial.rightCount - count;
-      if (spatial.cost < s.cost * (1.f - kSpatialSplitGain) && added <= room) s = spatial;
+      if (spatial.cost < s.cost * (1.0 - kSpatialSplitGain) && added <= room) s = spatial;
     }
     const unsigned mostInLeaf = box.volume() >= kRoomyVolume * rootVolume_ ? kRoomyLeaf : kMaxLeaf;
-    if (s.axis >= 0 && count <= mostInLeaf && kTriangleCost * float(count) <= s.cost) return makeLeaf(node, refs);
+    if (s.axis >= 0 && count <= mostInLeaf && kTriangleCost * double(count) <= s.cost) return makeLeaf(node, refs);
 
     // A spatial split's children own their references (this frame keeps them alive);
     // an object split's partition the node's in place.
@@ -378,13 +456,14 @@ class BinaryBuilder {
     }
     if (!s.spatial && s.axis >= 0) {
       Reference* mid = std::partition(refs.first, refs.last, [&](const Reference& r) {
-        return r.box.centroid()[size_t(s.axis)] < s.position;
+        return centroids.bin(r.box, size_t(s.axis)) <= s.bin;
       });
       left = {refs.first, mid};
       right = {mid, refs.last};
     }
     if (left.size() == 0 || right.size() == 0) {
-      // All centroids coincide (or binning could not separate them).
+      // All centroids coincide (no object split), or unsplitting sent every piece one way
+      // and the object split was no split either.
       if (count <= kMaxLeaf) return makeLeaf(node, refs);
       left = {refs.first, refs.first + count / 2};
       right = {refs.first + count / 2, refs.last};
@@ -431,8 +510,8 @@ class BinaryBuilder {
   }
 
   const float3* corners_;
-  float rootArea_;
-  float rootVolume_;  // INFINITY for a flat scene: no node is roomy
+  double rootArea_;
+  double rootVolume_;  // INFINITY for a flat scene: no node is roomy
   int parallelDepth_;
   BinaryTree tree_;
 };
@@ -441,10 +520,10 @@ class BinaryBuilder {
 // kTriangleCost per triangle tested, each weighted by its box's area over the root's): the
 // build's quality, comparable between builders.
 double sahCost(const std::vector<BinaryNode>& nodes) {
-  const double root = std::max(double(nodes[0].box.area()), 1e-30);
+  const double root = std::max(nodes[0].box.area(), kMinArea);
   double cost = 0.0;
   for (const BinaryNode& n : nodes)
-    cost += double(n.box.area()) / root * (n.count == 0 ? kTraversalCost : kTriangleCost * double(n.count));
+    cost += n.box.area() / root * (n.count == 0 ? kTraversalCost : kTriangleCost * double(n.count));
   return cost;
 }
 
@@ -496,7 +575,7 @@ class WideCollapser {
   // Children before parents would need the builder's numbering; an explicit post-order
   // does not.
   void planSubtrees() {
-    const float rootArea = std::max(binary_[0].box.area(), 1e-30f), rootVolume = binary_[0].box.volume();
+    const double rootArea = std::max(binary_[0].box.area(), kMinArea), rootVolume = binary_[0].box.volume();
     std::vector<std::pair<int, bool>> stack = {{0, false}};
     while (!stack.empty()) {
       const auto [b, childrenDone] = stack.back();
@@ -512,10 +591,11 @@ class WideCollapser {
     }
   }
 
-  // A box's chance of being visited, relative to the root's (see kVolumeWeight).
-  static float visitWeight(const Box& box, float rootArea, float rootVolume) {
-    const float volume = rootVolume > 0.f ? kVolumeWeight * box.volume() / rootVolume : 0.f;
-    return box.area() / rootArea + volume;
+  // A box's chance of being visited, relative to the root's (see kVolumeWeight): ratios of
+  // a box's to its root's, at most 1 + kVolumeWeight.
+  static float visitWeight(const Box& box, double rootArea, double rootVolume) {
+    const double volume = rootVolume > 0.0 ? kVolumeWeight * box.volume() / rootVolume : 0.0;
+    return float(box.area() / rootArea + volume);
   }
 
   void planNode(int b, float weight) {
@@ -671,15 +751,20 @@ Bvh buildBvh(const Scene& scene, BvhOptions options) {
 
   Bvh bvh;
   std::vector<float3> corners;
+  // The loader rejects these scenes; one built otherwise gets the same word.
+  if (scene.triangleCount() == 0) throw Error("BVH: the scene has no triangles");
   std::vector<Reference> refs = triangleReferences(scene, threads, corners);
+  for (size_t k = 0; k < corners.size(); ++k)
+    if (!isFinite(corners[k]))
+      throw Error("BVH: triangle " + std::to_string(k / 3) + " has a non-finite vertex coordinate");
   Box sceneBox;
   for (const Reference& r : refs) sceneBox.grow(r.box);
   // Levels that fork: enough subtrees for every thread, and some over for uneven splits.
   int parallelDepth = 0;
   while (threads > 1 && (1u << parallelDepth) < 4 * threads) ++parallelDepth;
   const size_t room = size_t(double(options.spatialSplitBudget) * double(refs.size()));
-  const float sceneVolume = sceneBox.volume() > 0.f ? sceneBox.volume() : INFINITY;
-  BinaryBuilder builder(corners.data(), std::max(sceneBox.area(), 1e-30f), sceneVolume, parallelDepth);
+  const double sceneVolume = sceneBox.volume() > 0.0 ? sceneBox.volume() : INFINITY;
+  BinaryBuilder builder(corners.data(), std::max(sceneBox.area(), kMinArea), sceneVolume, parallelDepth);
   const BinaryTree binary = builder.build({refs.data(), refs.data() + refs.size()}, room);
   bvh.stats.binaryNodes = binary.nodes.size();
   bvh.stats.references = binary.leafTriangles.size();
