@@ -49,6 +49,7 @@ fuzz scene_loader scene 1200
 fuzz camera_json camera 12000
 fuzz image_read image 200
 fuzz checkpoint checkpoint 1000
+fuzz bvh_build bvh 2000
 
 echo "sanitize: ThreadSanitizer, multi-device suites" >&2
 configure build-tsan thread
