@@ -157,6 +157,22 @@ TEST(Budgets, EveryBudgetRendersAtLeastOnePass) {
   EXPECT_NE(metadataOf(dir + "/two.exr", "estimated_relmse"), "");
 }
 
+// A resumed render says where it starts, and counts only the samples it renders itself.
+TEST(Budgets, AResumedRenderSaysSoAndCountsItsOwnSamples) {
+  const std::string dir = test::tempDir("budget");
+  auto r = test::runFredholm("render --width 16 --height 16 --spp 4 --checkpoint " + dir + "/c.film -o " + dir + "/a.png");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  r = test::runFredholm("render --width 16 --height 16 --spp 6 --resume " + dir + "/c.film -o " + dir + "/b.png");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("resuming from '" + dir + "/c.film': passes 0:4 rendered; rendering from pass 4"),
+            std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("fredholm: " + std::to_string(16 * 16 * 2) + " samples in"), std::string::npos) << r.output;
+  r = test::runFredholm("render --width 16 --height 16 --spp 3 --resume " + dir + "/c.film -o " + dir + "/c.png");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("as many as --spp 3 asks: nothing left to render"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("on no device (nothing left to render)"), std::string::npos) << r.output;
+}
+
 // CLI11's own words never reach the user: each parse error names the flag and what it takes.
 TEST(CliWords, ParseErrorsNameTheFlagAndWhatItTakes) {
   const std::pair<const char*, const char*> cases[] = {

@@ -66,7 +66,6 @@ void OutputPlan::reserve() {
                                                                     : CommitRule::Keep;
     reserveTarget(e.path, e.what, rule);
   }
-  reserved_ = true;
 }
 
 void OutputPlan::checkAgainstInputs() const {
@@ -87,8 +86,8 @@ void OutputPlan::finish() const {
   if (!moved.empty()) throw Error(moved);
 }
 
+// Also after a reserve() that failed part-way: the reservations it made go too.
 OutputPlan::~OutputPlan() {
-  if (!reserved_) return;
   for (const Entry& e : entries_) releaseTarget(e.path);
 }
 

@@ -42,7 +42,6 @@ class OutputPlan {
   };
   bool force_;
   std::vector<Entry> entries_;
-  bool reserved_ = false;
 };
 
 }  // namespace fh

@@ -229,6 +229,16 @@ std::vector<std::string> planOutputs(RenderOptions& o, RenderSettings& settings,
   return layers;
 }
 
+// A resumed render says what it starts from, and when the checkpoint holds every pass asked for.
+void reportResume(const RenderOptions& o, const RenderSettings& settings) {
+  const Film& film = *settings.resume;
+  std::cerr << "fredholm: resuming from '" << o.resume << "': passes " << film.describePasses() << " rendered";
+  if (!settings.adaptive && film.nextPass() >= uint64_t(settings.spp))
+    std::cerr << ", as many as --spp " << settings.spp << " asks: nothing left to render\n";
+  else
+    std::cerr << "; rendering from pass " << film.nextPass() << "\n";
+}
+
 // This process's rank when it is one of several sharing the render (mpirun), else 0.
 int mpiRank(const RenderOptions& o) {
 #ifdef FREDHOLM_HAVE_MPI
@@ -344,6 +354,7 @@ int runRender(RenderOptions o) {
     settings.resume = o.mpi ? resumeRanks(o, rank, settings.fingerprint)
                             : std::make_shared<Film>(loadCheckpoint(o.resume, settings.fingerprint, "--resume"));
   }
+  if (settings.resume && rank == 0) reportResume(o, settings);
   plan.checkAgainstInputs();
   const auto start = std::chrono::steady_clock::now();
   const Bvh bvh = buildBvh(scene);

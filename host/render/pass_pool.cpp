@@ -34,7 +34,7 @@ PassPool::PassPool(const RenderSettings& s, int workers)
       lastCheckpoint_(std::chrono::steady_clock::now()) {
   // A resumed render goes on from the first pass its film lacks; a chunk starts at its first.
   next_ = nextToMerge_ = firstNew_ = uint32_t(film_.nextPass());
-  mergedSamples_ = film_.samples();
+  mergedSamples_ = resumedSamples_ = film_.samples();
   samplesDone_.assign(size_t(workers), 0);
   if (!s.adaptive) {
     addRound(0, nullptr);
@@ -174,7 +174,7 @@ Film PassPool::finish(bool& complete) {
   }
   pending_.clear();
   if (settings_.ledger) progress_.end();  // other processes may still be rendering
-  else progress_.finish(uint64_t(mergedSamples_), secondsSince(start_));
+  else progress_.finish(uint64_t(mergedSamples_ - resumedSamples_), secondsSince(start_));
   return film_;
 }
 
@@ -326,10 +326,11 @@ void PassPool::showProgress() {
   const bool timed = settings_.seconds > 0.0, noisy = settings_.noise > 0.0;
   // relMSE falls as 1 / samples, so target / estimate is the share of samples taken.
   const double noiseShare = noiseEstimate_ > 0.0 ? std::min(1.0, settings_.noise / noiseEstimate_) : 0.0;
-  const uint64_t passes = total_ - settings_.firstPass;  // this render's, or this chunk's
+  // This run's work only: a chunk's passes, or those a resumed render adds to its checkpoint.
+  const uint64_t passes = total_ - std::min(total_, firstNew_);
   const uint64_t elsewhere = settings_.ledger ? settings_.ledger->finishedElsewhere() : 0;
-  const uint64_t samples = settings_.adaptive ? sampleBudget_ : passes * film_.pixels();
-  progress_.update(uint64_t(mergedSamples_) + elsewhere * film_.pixels(), timed || noisy ? 0 : samples, elapsed,
+  const uint64_t samples = settings_.adaptive ? sampleBudget_ - uint64_t(resumedSamples_) : passes * film_.pixels();
+  progress_.update(uint64_t(mergedSamples_ - resumedSamples_) + elsewhere * film_.pixels(), timed || noisy ? 0 : samples, elapsed,
                    noisy ? std::min(1.0, std::max(noiseShare, timed ? elapsed / settings_.seconds : 0.0))
                          : timed ? std::min(1.0, elapsed / settings_.seconds) : 0.0);
 }

@@ -80,7 +80,8 @@ class PassPool : public PassSource {
   bool started_ = false;
   uint32_t next_ = 0, nextToMerge_ = 0;
   uint32_t firstNew_ = 0;  // the first pass this render hands out (a time budget allows it always)
-  double mergedSamples_ = 0;  // in the film: what the progress display counts
+  double mergedSamples_ = 0;  // in the film
+  double resumedSamples_ = 0;  // in the film a resumed render started from: not this run's work
   // The rounds whose pixels are known, in order, from the one being merged on.
   std::deque<Round> rounds_;
   std::shared_ptr<const PixelList> everyPixel_;  // a checkpoint's list for rounds of every pixel

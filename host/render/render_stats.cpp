@@ -41,7 +41,8 @@ std::string RenderStats::contributors() const {
   std::string names;
   for (const auto& d : devices)
     if (d.samples > 0) names += (names.empty() ? "" : ", ") + d.name;
-  return names;
+  // A resumed render whose checkpoint held every pass asked for rendered on none.
+  return names.empty() ? "no device (nothing left to render)" : names;
 }
 
 std::string statsJson(const RenderStats& st, const RenderSettings& s) {
