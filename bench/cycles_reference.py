@@ -69,7 +69,9 @@ def read_mtl(obj_path):
                     current = words[1]
                     materials[current] = {"Kd": (0.0, 0.0, 0.0), "Ke": (0.0, 0.0, 0.0)}
                 elif key in ("Kd", "Ke") and current:
-                    materials[current][key] = tuple(float(v) for v in words[1:4])
+                    values = tuple(float(v) for v in words[1:4])
+                    # One value is grey, as the MTL specification and fredholm read it.
+                    materials[current][key] = values * 3 if len(values) == 1 else values
                 elif key == "Ks" and any(float(v) != 0.0 for v in words[1:4]):
                     fail(f"{path}:{number}: Ks is not 0: only diffuse + emission scenes have an exact Cycles twin")
                 elif key == "illum" and int(words[1]) > 2:

@@ -7,12 +7,11 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 
 #include "base/error.h"
+#include "base/input_file.h"
 #include "base/vec.h"
 #include "device/kernel_sources.h"
 #include "scene/obj_lint.h"
@@ -25,21 +24,6 @@ namespace fs = std::filesystem;
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
   return s;
-}
-
-// Reads a whole file; errors say why it cannot be read.
-std::string readTextFile(const fs::path& path, const std::string& what) {
-  std::error_code ec;
-  const auto status = fs::status(path, ec);
-  if (ec || !fs::exists(status)) throw Error(path.string() + ": " + what + " not found");
-  if (fs::is_directory(status)) throw Error(path.string() + ": is a directory, not " + what);
-  // A device, FIFO or socket could block or never end (/dev/zero).
-  if (!fs::is_regular_file(status)) throw Error(path.string() + ": not a regular file, so not " + what);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path.string() + ": cannot open " + what);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
 }
 
 // The path as given if it exists, else a case-insensitive match component by component
@@ -103,10 +87,10 @@ void addTextures(Scene& scene, const std::vector<tinyobj::material_t>& source, c
                                "' not found; using its Kd instead");
       continue;
     }
-    std::error_code ec;
-    if (!fs::is_regular_file(resolved, ec)) {  // a directory, a device, a FIFO
-      scene.warnings.push_back("material '" + source[i].name + "': texture '" + resolved.string() +
-                               "' is not a regular file; using its Kd instead");
+    try {
+      checkInputFile(resolved.string(), "texture");  // not a directory, a device, a FIFO
+    } catch (const Error& e) {
+      scene.warnings.push_back("material '" + source[i].name + "': " + e.what() + "; using its Kd instead");
       continue;
     }
     const std::string key = resolved.string();
@@ -186,10 +170,10 @@ void flattenShapes(Scene& scene, const tinyobj::attrib_t& attrib, const std::vec
   if (degenerate) scene.warnings.push_back(std::to_string(degenerate) + " degenerate (zero-area) triangle(s)");
 }
 
-Scene buildScene(const SceneText& text, const ObjLintReport& report) {
+Scene buildScene(const SceneText& text, const ObjLintReport& report, const std::vector<std::string>& warnings) {
   Scene scene;
   scene.sourcePath = text.objName;
-  scene.warnings = report.warnings;
+  scene.warnings = warnings;
 
   tinyobj::ObjReaderConfig config;
   config.triangulate = true;
@@ -251,27 +235,36 @@ void Scene::bounds(Vec3f& lo, Vec3f& hi) const {
   }
 }
 
+// The OBJ and MTL text tinyobjloader parses is the lints' (scene/obj_lint.h): what they read,
+// line for line, so that no statement or number reaches the loader unchecked.
 Scene loadScene(const std::string& objPath) {
   const fs::path path(objPath);
   SceneText text;
   text.objName = objPath;
-  text.obj = readTextFile(path, "OBJ file");
   text.baseDir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  ObjLintReport report = lintObj(readInputFile(objPath, "scene"), objPath);
+  text.obj = std::move(report.text);
+  std::vector<std::string> warnings = report.warnings;
 
-  const ObjLintReport report = lintObj(text.obj, objPath);
   std::set<std::string> used;
   for (const auto& use : report.usemtls) used.insert(use.argument);
   for (const auto& lib : report.mtllibs) {
+    const std::string where = objPath + ":" + std::to_string(lib.line) + ": ";
     const fs::path mtlPath = resolveCaseInsensitive(text.baseDir, lib.argument);
     if (mtlPath.empty())
-      throw Error(objPath + ":" + std::to_string(lib.line) + ": material library '" + lib.argument +
-                  "' not found in " + text.baseDir.string());
-    const std::string mtl = readTextFile(mtlPath, "MTL file");
+      throw Error(where + "material library '" + lib.argument + "' not found in " + text.baseDir.string());
+    std::string mtl;
+    try {
+      mtl = readInputFile(mtlPath.string(), "mtllib");
+    } catch (const Error& e) {
+      throw Error(where + e.what());
+    }
     // An empty library is legal: buildScene warns about every material it lacks.
-    lintMtl(mtl, mtlPath.string());
-    text.mtl += keepUsedMaterials(mtl, used) + "\n";
+    MtlLintReport lint = lintMtl(mtl, mtlPath.string(), &used);
+    warnings.insert(warnings.end(), lint.warnings.begin(), lint.warnings.end());
+    text.mtl += lint.text + "\n";
   }
-  Scene scene = buildScene(text, report);
+  Scene scene = buildScene(text, report, warnings);
 
   const fs::path sidecar = fs::path(path).replace_extension(".camera.json");
   std::error_code ec;
@@ -286,10 +279,13 @@ Scene loadDefaultScene() {
   const std::string base = "scenes/cornell-box/CornellBox-Original";
   SceneText text;
   text.objName = "<built-in> " + base + ".obj";
-  text.obj = embeddedFile(base + ".obj");
-  text.mtl = embeddedFile(base + ".mtl");
-  lintMtl(text.mtl, "<built-in> " + base + ".mtl");
-  Scene scene = buildScene(text, lintObj(text.obj, text.objName));
+  ObjLintReport report = lintObj(embeddedFile(base + ".obj"), text.objName);
+  MtlLintReport mtl = lintMtl(embeddedFile(base + ".mtl"), "<built-in> " + base + ".mtl");
+  text.obj = std::move(report.text);
+  text.mtl = std::move(mtl.text);
+  std::vector<std::string> warnings = report.warnings;
+  warnings.insert(warnings.end(), mtl.warnings.begin(), mtl.warnings.end());
+  Scene scene = buildScene(text, report, warnings);
   scene.camera = parseCameraJson(embeddedFile(base + ".camera.json"), "<built-in> " + base + ".camera.json");
   scene.hasCamera = true;
   return scene;

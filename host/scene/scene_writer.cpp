@@ -26,17 +26,33 @@ void writeTriple(std::ostringstream& out, const char* key, const Vec3f& v) {
   out << key << ' ' << v[0] << ' ' << v[1] << ' ' << v[2] << '\n';
 }
 
-std::string mtlText(const Scene& scene) {
+// A texture's path as the MTL in `mtlDir` names it: relative to that directory (as the loader
+// resolves it), so the exported scene moves with its textures. Absolute where the two share
+// no directory but the root: a path climbing to the root would only break when moved.
+std::string texturePath(const std::string& texture, const fs::path& mtlDir) {
+  const fs::path target = fs::absolute(texture).lexically_normal();
+  size_t shared = 0;
+  for (auto a = target.begin(), b = mtlDir.begin(); a != target.end() && b != mtlDir.end() && *a == *b; ++a, ++b)
+    ++shared;
+  const fs::path relative = target.lexically_relative(mtlDir);
+  if (shared < 2 || relative.empty()) return target.generic_string();
+  const std::string text = relative.generic_string();
+  return text[0] == '-' ? "./" + text : text;  // a leading '-' would read as a texture option
+}
+
+std::string mtlText(const Scene& scene, const fs::path& mtlDir) {
   std::ostringstream out = textWriter();
   out << "# written by fredholm export from " << scene.sourcePath << "\n";
   for (const Material& m : scene.materials) {
+    // tinyobjloader adds a material without a name for an empty library; no face can use it.
+    if (m.name.empty()) continue;
     out << "\nnewmtl " << m.name << '\n';
     writeTriple(out, "Kd", m.kd);
     writeTriple(out, "Ks", m.ks);
     writeTriple(out, "Ke", m.ke);
     if (m.isGlass()) writeTriple(out, "Tf", m.tf);
     out << "Ns " << m.ns << "\nNi " << m.ni << "\nd " << m.d << "\nillum " << m.illum << '\n';
-    if (m.kdTexture >= 0) out << "map_Kd " << fs::absolute(scene.textures[size_t(m.kdTexture)].path).string() << '\n';
+    if (m.kdTexture >= 0) out << "map_Kd " << texturePath(scene.textures[size_t(m.kdTexture)].path, mtlDir) << '\n';
   }
   return out.str();
 }
@@ -83,7 +99,7 @@ std::vector<std::string> writeObjScene(const Scene& scene, const std::string& ob
   std::vector<std::string> paths = {objPath, mtl};
   if (scene.hasCamera) paths.push_back(camera);
   for (const std::string& p : paths) checkOutputFile(p, force, "-o");
-  writeTextAtomically(mtl, "-o", mtlText(scene));
+  writeTextAtomically(mtl, "-o", mtlText(scene, fs::absolute(mtl).parent_path().lexically_normal()));
   writeTextAtomically(objPath, "-o", objText(scene, fs::path(mtl).filename().string()));
   if (scene.hasCamera) writeTextAtomically(camera, "-o", cameraText(scene.camera));
   return paths;
