@@ -87,6 +87,9 @@ TEST(OutputPlan, InputsAreNeverOverwritten) {
     EXPECT_EQ(r.exitCode, 1) << flags << ": " << r.output;
     EXPECT_NE(r.output.find(message), std::string::npos) << flags << ": " << r.output;
   }
+  const auto exported = test::runFredholm("export " + scene + " --force -o " + scene);
+  EXPECT_EQ(exported.exitCode, 1) << exported.output;
+  EXPECT_NE(exported.output.find("-o '" + scene + "': is the scene"), std::string::npos) << exported.output;
   EXPECT_EQ(readAll(scene), before);
   EXPECT_EQ(readAll(dir + "/features.mtl"), mtl);
   EXPECT_EQ(temporaryFiles(dir), 0);

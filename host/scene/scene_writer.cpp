@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "base/atomic_file.h"
+#include "base/output_plan.h"
 #include "base/error.h"
 #include "image/image_io.h"
 
@@ -98,11 +99,18 @@ std::vector<std::string> writeObjScene(const Scene& scene, const std::string& ob
   const std::string camera = fs::path(objPath).replace_extension(".camera.json").string();
   std::vector<std::string> paths = {objPath, mtl};
   if (scene.hasCamera) paths.push_back(camera);
-  for (const std::string& p : paths) checkOutputFile(p, force, "-o");
-  writeTextAtomically(mtl, "-o", mtlText(scene, fs::absolute(mtl).parent_path().lexically_normal()));
-  writeTextAtomically(objPath, "-o", objText(scene, fs::path(mtl).filename().string()));
-  if (scene.hasCamera) writeTextAtomically(camera, "-o", cameraText(scene.camera));
-  return paths;
+  OutputPlan plan(force);
+  for (const std::string& p : paths) plan.add(p, "-o");
+  plan.reserve();
+  plan.checkAgainstInputs();
+  // The MTL first: the OBJ names it as written (a file that appeared meanwhile is kept).
+  const std::string mtlWritten =
+      writeTextAtomically(mtl, "-o", mtlText(scene, fs::absolute(mtl).parent_path().lexically_normal()));
+  std::vector<std::string> written = {
+      writeTextAtomically(objPath, "-o", objText(scene, fs::path(mtlWritten).filename().string())), mtlWritten};
+  if (scene.hasCamera) written.push_back(writeTextAtomically(camera, "-o", cameraText(scene.camera)));
+  plan.finish();
+  return written;
 }
 
 }  // namespace fh
