@@ -214,7 +214,7 @@ TEST(Chunks, OverlapsOtherRendersGapsAndBadFlagsAreCaught) {
            {"merge " + dir + "/p0.film " + dir + "/p2.film -o " + dir + "/x.exr", "shares passes"},
            {"merge " + dir + "/p0.film " + dir + "/other.film -o " + dir + "/x.exr", "a chunk of another render"},
            {"merge " + dir + "/p0.film " + dir + "/missing.film -o " + dir + "/x.exr", "cannot read"},
-           {"merge " + dir + "/p0.film", "--output is required"},
+           {"merge " + dir + "/p0.film", "missing --output (Output image"},
            {render + "--passes 4:4 --film " + dir + "/e.film", "0 <= A < B"},
            {render + "--passes -1:4 --film " + dir + "/e.film", "0 <= A < B"},
            {render + "--passes 0:4", "give --film"},

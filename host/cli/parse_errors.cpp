@@ -20,12 +20,9 @@ std::string expectedValue(const CLI::Option& option) {
   return "a value";
 }
 
-const CLI::Option* findOption(const CLI::App& app, const std::string& name) {
-  for (const CLI::App* command : app.get_subcommands({})) {
-    for (const CLI::Option* option : command->get_options())
-      if (option->check_name(name)) return option;
-  }
-  for (const CLI::Option* option : app.get_options())
+// The option of that name in the command given (`command`, or the app's own).
+const CLI::Option* findOption(const CLI::App& command, const std::string& name) {
+  for (const CLI::Option* option : command.get_options())
     if (option->check_name(name)) return option;
   return nullptr;
 }
@@ -44,7 +41,8 @@ const CLI::App* commandGiven(const CLI::App& app, int argc, char** argv) {
   return nullptr;
 }
 
-std::string explain(const CLI::App& app, const CLI::ParseError& error, int argc, char** argv) {
+std::string explain(const CLI::App& app, const CLI::App& command, const CLI::ParseError& error, int argc,
+                    char** argv) {
   const std::string what = error.what();
   std::smatch m;
   if (dynamic_cast<const CLI::RequiredError*>(&error) && what.find("subcommand") != std::string::npos) {
@@ -53,17 +51,17 @@ std::string explain(const CLI::App& app, const CLI::ParseError& error, int argc,
     return "give a command: " + commandList(app);
   }
   if (std::regex_match(what, m, std::regex("Could not convert: (\\S+) = (.*)"))) {
-    const CLI::Option* option = findOption(app, m[1].str());
+    const CLI::Option* option = findOption(command, m[1].str());
     return m[1].str() + " '" + m[2].str() + "': expected " + (option ? expectedValue(*option) : "another value");
   }
   if (std::regex_match(what, m, std::regex("(\\S+): At Most 1 required but received (\\d+)")))
     return m[1].str() + " is given " + m[2].str() + " times; give it once";
   if (std::regex_match(what, m, std::regex("(\\S+): (\\d+) required (\\S+) missing"))) {
-    const CLI::Option* option = findOption(app, m[1].str());
+    const CLI::Option* option = findOption(command, m[1].str());
     return m[1].str() + " needs a value (" + (option ? expectedValue(*option) : "a value") + ")";
   }
   if (std::regex_match(what, m, std::regex("(\\S+) is required"))) {
-    const CLI::Option* option = findOption(app, m[1].str());
+    const CLI::Option* option = findOption(command, m[1].str());
     return "missing " + m[1].str() + (option && !option->get_description().empty()
                                           ? " (" + option->get_description() + ")" : "");
   }
@@ -78,7 +76,8 @@ std::string explain(const CLI::App& app, const CLI::ParseError& error, int argc,
 
 std::string explainParseError(const CLI::App& app, const CLI::ParseError& error, int argc, char** argv) {
   const CLI::App* command = commandGiven(app, argc, argv);
-  return explain(app, error, argc, argv) + " (see fredholm " + (command ? command->get_name() + " " : "") + "--help)";
+  return explain(app, command ? *command : app, error, argc, argv) + " (see fredholm " +
+         (command ? command->get_name() + " " : "") + "--help)";
 }
 
 }  // namespace fh
