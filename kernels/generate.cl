@@ -13,8 +13,9 @@
 // shape's i-th listed pixel into entry j % entries of the pass buffers (pass_entry, with
 // the slot). Samples before newer.first_sample are of the older shape. The sample is point
 // pass + offset of its pixel's sequence (the listed pixel's offset, two list halves on:
-// host/render/pass_source.h), and global sample k = point * pixel_count + pixel seeds the
-// random numbers, so a sample is the same whichever device renders it.
+// host/render/pass_source.h), and the pixel and its point seed the random numbers, so a
+// sample is the same whichever device renders it, and no sample number of the render
+// (point * pixels + pixel) is formed that could overflow.
 FH_INLINE void start_sample(RenderParams params, PassShape older, PassShape newer, uint entries, luint j, luint slot,
                             lmask active, __global const float* filter_table, __global const uint* pass_table,
                             __global const uint* pixel_list FH_PATH_PARAMS) {
@@ -27,8 +28,7 @@ FH_INLINE void start_sample(RenderParams params, PassShape older, PassShape newe
   const luint listed = select((luint)(older.list), (luint)(newer.list), is_newer) + index;
   const luint pixel = gather_uint(pixel_list, listed);
   const luint point = gather_uint(pass_table, pass_slot) + gather_uint(pixel_list, listed + 2u * params.pixel_count);
-  const luint k = point * params.pixel_count + pixel;
-  const PixelSampler sampler = pixel_sampler(params.seed, k, params.pixel_count, params.replicates);
+  const PixelSampler sampler = pixel_sampler_at(params.seed, point, pixel, params.replicates);
   const lvec2 u = sample_2d(&sampler, (luint)(FH_DIM_PIXEL));
   const uint width = (uint)params.camera.width;
   const lfloat px = lconvert_float(pixel % width) + 0.5f + filter_offset(filter_table, params.filter_table_size, u.x);

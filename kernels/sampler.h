@@ -55,18 +55,26 @@ typedef struct {
   luint index_reversed;
 } PixelSampler;
 
-// With replicates == 2 (a noise target: host/render/film.h), a pixel's even and odd points
-// are two sequences under independent scramblings, each a net in its own right: the
-// difference of their means is an unbiased estimate of the image's error, which the
-// correlated points of one sequence do not give. replicates == 1: one sequence. (A point's
-// parity is its pass's, by which the film sorts: sequence offsets are even.)
-FH_INLINE PixelSampler pixel_sampler(uint seed, luint sample_id, uint pixel_count, uint replicates) {
+// Point `point` of pixel `pixel`'s sequence. With replicates == 2 (a noise target:
+// host/render/film.h), a pixel's even and odd points are two sequences under independent
+// scramblings, each a net in its own right: the difference of their means is an unbiased
+// estimate of the image's error, which the correlated points of one sequence do not give.
+// replicates == 1: one sequence. (A point's parity is its pass's, by which the film sorts:
+// sequence offsets are even.) The point and the pixel are taken apart, never as one sample
+// number (point * pixels + pixel), so an image of any size has 2^32 points per pixel.
+FH_INLINE PixelSampler pixel_sampler_at(uint seed, luint point, luint pixel, uint replicates) {
   PixelSampler s;
-  const luint point = sample_id / pixel_count, shift = (luint)(replicates - 1u);
+  const luint shift = (luint)(replicates - 1u);
   const luint replicate = point & shift;
-  s.pixel_seed = hash_combine((luint)(seed) + replicate * 0x9e3779b9u, sample_id % pixel_count);
+  s.pixel_seed = hash_combine((luint)(seed) + replicate * 0x9e3779b9u, pixel);
   s.index_reversed = reverse_bits_u32(point >> shift);
   return s;
+}
+
+// The same for sample `sample_id` = point * pixel_count + pixel (below 2^32 samples: the
+// sampler's tests number them so).
+FH_INLINE PixelSampler pixel_sampler(uint seed, luint sample_id, uint pixel_count, uint replicates) {
+  return pixel_sampler_at(seed, sample_id / pixel_count, sample_id % pixel_count, replicates);
 }
 
 // The index of this sample in dimension `dimension`'s own order: an Owen scrambling of the
