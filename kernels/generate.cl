@@ -6,20 +6,23 @@
 #include "path_state.h"
 #include "sampler.h"
 
-// Starts device sample j (a device numbers its samples locally) in path slot `slot`. Its
-// passes are granted by the host, which may hand different passes to different devices:
-// from a shape's first sample on, every shape.pixels samples are one local pass, whose
-// global pass is in pass_table at its pass slot, and sample i of a pass renders the
-// shape's i-th listed pixel into entry j % entries of the pass buffers (pass_entry, with
-// the slot). Samples before newer.first_sample are of the older shape. The sample is point
-// pass + offset of its pixel's sequence (the listed pixel's offset, two list halves on:
-// host/render/pass_source.h), and the pixel and its point seed the random numbers, so a
-// sample is the same whichever device renders it, and no sample number of the render
-// (point * pixels + pixel) is formed that could overflow.
+// Starts device sample j (a device numbers its samples locally, mod 2^32) in path slot
+// `slot`. Its passes are granted by the host, which may hand different passes to different
+// devices: from a shape's first sample on, every shape.pixels samples are one local pass,
+// whose global pass and first entry in the pass buffers are in pass_table at its pass slot,
+// and sample i of a pass renders the shape's i-th listed pixel into the entry i after its
+// pass's (pass_entry, with the slot), around the ring of `entries`. Samples before
+// newer.first_sample are of the older shape; local numbers wrap, so samples are compared by
+// their distance from the older shape's first (the host starts a new shape before one
+// spans 2^31 samples). The sample is point pass + offset of its pixel's sequence (the
+// listed pixel's offset, two list halves on: host/render/pass_source.h), and the pixel and
+// its point seed the random numbers, so a sample is the same whichever device renders it,
+// and no sample number of the render (point * pixels + pixel) is formed that could
+// overflow.
 FH_INLINE void start_sample(RenderParams params, PassShape older, PassShape newer, uint entries, luint j, luint slot,
                             lmask active, __global const float* filter_table, __global const uint* pass_table,
                             __global const uint* pixel_list FH_PATH_PARAMS) {
-  const lmask is_newer = j >= newer.first_sample;
+  const lmask is_newer = j - older.first_sample >= (luint)(newer.first_sample - older.first_sample);
   const luint pixels = select((luint)(older.pixels), (luint)(newer.pixels), is_newer);
   const luint in_shape = j - select((luint)(older.first_sample), (luint)(newer.first_sample), is_newer);
   const luint local_pass = select((luint)(older.first_pass), (luint)(newer.first_pass), is_newer) + in_shape / pixels;
@@ -27,7 +30,8 @@ FH_INLINE void start_sample(RenderParams params, PassShape older, PassShape newe
   const luint index = in_shape % pixels;
   const luint listed = select((luint)(older.list), (luint)(newer.list), is_newer) + index;
   const luint pixel = gather_uint(pixel_list, listed);
-  const luint point = gather_uint(pass_table, pass_slot) + gather_uint(pixel_list, listed + 2u * params.pixel_count);
+  const luint point = gather_uint(pass_table, 2u * pass_slot) + gather_uint(pixel_list, listed + 2u * params.pixel_count);
+  const luint entry = (gather_uint(pass_table, 2u * pass_slot + 1u) + index) % entries;
   const PixelSampler sampler = pixel_sampler_at(params.seed, point, pixel, params.replicates);
   const lvec2 u = sample_2d(&sampler, (luint)(FH_DIM_PIXEL));
   const uint width = (uint)params.camera.width;
@@ -41,7 +45,7 @@ FH_INLINE void start_sample(RenderParams params, PassShape older, PassShape newe
   // Kept, not recomputed at every bounce from the sample's index (divisions and hashes).
   scatter_uint(pixel_seed, slot, sampler.pixel_seed, active);
   scatter_uint(point_reversed, slot, sampler.index_reversed, active);
-  scatter_uint(pass_entry, slot, FH_PASS_ENTRY(j % entries, pass_slot), active);
+  scatter_uint(pass_entry, slot, FH_PASS_ENTRY(entry, pass_slot), active);
   scatter_uint(depth, slot, (luint)(0), active);
 }
 

@@ -12,14 +12,16 @@
 
 __kernel void plan_iteration(volatile __global WavefrontCounters* counters, uint parity) {
   if (get_global_id(0) != 0) return;
-  const uint free_slots = counters->free_length, next = counters->next_sample, limit = counters->sample_limit;
+  // Local sample numbers wrap (mod 2^32): the samples granted and not yet started are
+  // limit - next, which the host keeps far below 2^32.
+  const uint free_slots = counters->free_length, next = counters->next_sample, ready = counters->sample_limit - next;
 #if defined(FH_MEGAKERNEL)
   // Every path a megakernel launch starts ends in it: no rays carry over, and the slots
   // are all free again (and stay in the free list) when it is done.
-  const uint count = min(FH_MEGAKERNEL_SAMPLES_PER_SLOT * free_slots, limit - min(limit, next));
+  const uint count = min(FH_MEGAKERNEL_SAMPLES_PER_SLOT * free_slots, ready);
   counters->ray_length[parity] = 0;
 #else
-  const uint count = min(free_slots, limit - min(limit, next));
+  const uint count = min(free_slots, ready);
   counters->free_length = free_slots - count;
 #endif
   counters->new_count = count;

@@ -115,7 +115,8 @@ typedef struct {
 
 // The shape of a run of passes: each covers `pixels` pixels, those listed from `list` on in
 // the pixel list (every pixel, or an adaptive round's, render/adaptive.h); its first pass is
-// local pass `first_pass` and starts at local sample `first_sample`.
+// local pass `first_pass` and starts at local sample `first_sample` (local sample numbers
+// are 32 bits and wrap: host/render/wavefront.h).
 typedef struct {
   uint pixels;
   uint first_sample;
@@ -129,8 +130,8 @@ typedef struct {
   uint finished_length;  // paths finished this iteration
   uint free_length;      // free path slots: the free list's length
   uint nonfinite;        // samples whose radiance was NaN or infinite (dropped)
-  uint next_sample;      // samples started so far on this device (local numbering)
-  uint sample_limit;     // local samples that may start: the passes granted so far
+  uint next_sample;      // samples started so far on this device (local numbering, mod 2^32)
+  uint sample_limit;     // local samples that may start: the passes granted so far (mod 2^32)
   uint new_count;        // this iteration's new samples,
   uint new_first;        // ... the first one's local index,
   uint new_free_top;     // ... the free list's length before they took their slots,
@@ -141,8 +142,9 @@ typedef struct {
   uint iterations;
   // The passes in flight are of two shapes at most: shapes[1] from its first sample on,
   // shapes[0] before it (the host sets a new shape once every sample of shapes[0] has
-  // started). Local sample j writes entry j % pass_entries of the pass buffers, so a pass's
-  // entries follow its predecessor's whatever their shapes.
+  // started). A pass's samples write the entries of the pass buffers from its first one
+  // (the pass table's, kernels/generate.cl) on, around the ring of pass_entries, and a
+  // pass's entries follow its predecessor's whatever their shapes.
   PassShape shapes[2];
   uint pass_entries;
   uint pass_done[FH_MAX_PASS_SLOTS];  // per pass slot: paths finished in the pass it holds

@@ -128,18 +128,19 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
     throw Error(std::to_string(s.width) + "x" + std::to_string(s.height) + " is more than " +
                 std::to_string(mostEntries) + " pixels; render a smaller image");
   passEntries_ = std::min(fullPasses * pixels_, mostEntries / pixels_ * pixels_);
-  // Global sample numbers are 32 bits: at most spp passes (a time budget stops earlier; an
-  // adaptive render's passes cover fewer pixels, and its pool counts them).
-  if (uint64_t(std::max(1, s.spp)) * pixels_ >= (uint64_t(1) << 32))
-    throw Error("--spp " + std::to_string(s.spp) + " at " + std::to_string(s.width) + "x" + std::to_string(s.height) +
-                " is more than 2^32 samples in one render; render fewer");
+  // A few rings of pass entries: far below 2^31 (passEntries_ is at most 2^26), and far
+  // above the samples in flight, so that every sample of the older shape has started by the
+  // time the newer one outgrows its span (no wait for a new shape of the same pixels).
+  shapeSpan_ = 4 * uint64_t(passEntries_);
   passes_.assign(FH_MAX_PASS_SLOTS, {});
   everyPixel_ = everyPixel(pixels_);
   noOffsets_.assign(pixels_, 0u);
   lists_ = {everyPixel_, {}};
   offsets_ = {noOffsets_, {}};
-  shapes_[0] = shapes_[1] = {pixels_, 0, 0, 0};  // every pixel, listed in the first half
+  // Every pixel, listed in the first half.
+  shapes_[0] = shapes_[1] = {pixels_, uint32_t(kFirstLocalSample), 0, 0};
   std::copy(shapes_.begin(), shapes_.end(), counters_.shapes);
+  counters_.next_sample = counters_.sample_limit = uint32_t(kFirstLocalSample);
   counters_.pass_entries = uint32_t(passEntries_);
 
   const cl::Program program = buildProgram(
@@ -180,7 +181,7 @@ void WavefrontPipeline::allocateBuffers(const std::vector<float>& filterTable) {
   aovBuffers_ = buffer(surfaceAovs_ ? passEntries_ * kAovFloatsPerPixel * 4 : 16, "AOV buffers");
   filterTable_ = allocateBuffer(dc_.context, dc_.info.device, CL_MEM_READ_ONLY, filterTable.size() * 4,
                                 "filter table", filterTable.data());
-  passTableBuffer_ = buffer(FH_MAX_PASS_SLOTS * 4, "pass table");
+  passTableBuffer_ = buffer(FH_MAX_PASS_SLOTS * sizeof(PassInFlight::table), "pass table");
   // Each shape's list in a half of its own, then each one's sequence offsets (zero here).
   std::vector<uint32_t> lists(4 * size_t(pixels_), 0u);
   std::copy(everyPixel_.begin(), everyPixel_.end(), lists.begin());
@@ -258,39 +259,47 @@ bool WavefrontPipeline::fits(const std::shared_ptr<const RoundPixels>& pixels, u
   if (granted - returned >= FH_MAX_PASS_SLOTS) return false;
   const uint32_t size = pixels ? uint32_t(pixels->pixels.size()) : pixels_;
   // The pass buffers are a ring of entries in local sample order, from the oldest pass's.
-  const uint32_t oldest = granted == returned ? grantedSamples_ : passes_[returned % FH_MAX_PASS_SLOTS].firstSample;
-  if (size_t(grantedSamples_ - oldest) + size > passEntries_) return false;
-  // A new shape takes the pixel list of the older one: all its samples must have started
-  // (as of the last readCounters).
-  return pixels == shapePixels_[1] || counters_.next_sample >= shapes_[1].first_sample;
+  const uint64_t oldest = granted == returned ? grantedSamples_ : passes_[returned % FH_MAX_PASS_SLOTS].firstSample;
+  if (grantedSamples_ - oldest + size > passEntries_) return false;
+  // A new shape (of other pixels, or of the same ones once the newer shape outgrows its
+  // span) replaces the older one: all its samples must have started (as of the last
+  // readCounters).
+  return (pixels == shapePixels_[1] && !outgrowsShape(size)) || startedSamples_ >= shapeStart_;
 }
 
 void WavefrontPipeline::grantPass(uint64_t local, uint32_t global, std::shared_ptr<const RoundPixels> pixels) {
-  if (pixels != shapePixels_[1]) newShape(std::move(pixels), local);
+  const uint32_t size = pixels ? uint32_t(pixels->pixels.size()) : pixels_;
+  if (pixels != shapePixels_[1] || outgrowsShape(size)) newShape(std::move(pixels), local);
   const size_t slot = size_t(local % FH_MAX_PASS_SLOTS);  // free: its last pass was returned
-  passes_[slot] = {global, grantedSamples_, shapes_[1].pixels};
+  passes_[slot] = {grantedSamples_, shapes_[1].pixels, {global, uint32_t(grantedSamples_ % passEntries_)}};
   grantedSamples_ += shapes_[1].pixels;
-  FH_CL(dc_.queue.enqueueWriteBuffer(passTableBuffer_, CL_FALSE, slot * 4, 4, &passes_[slot].global));
+  FH_CL(dc_.queue.enqueueWriteBuffer(passTableBuffer_, CL_FALSE, slot * sizeof passes_[slot].table,
+                                     sizeof passes_[slot].table, passes_[slot].table));
 }
 
 // The newer shape becomes the older, and local pass `local` on is of the new one, whose
-// pixel list takes the half of the pixel-list buffer the older's older had.
+// pixel list takes the half of the pixel-list buffer the older's older had; or, for a new
+// shape of the newer's own pixels (it outgrew its span), the half the newer has.
 void WavefrontPipeline::newShape(std::shared_ptr<const RoundPixels> pixels, uint64_t local) {
+  const bool samePixels = pixels == shapePixels_[1];
   const std::vector<uint32_t>& list = pixels ? pixels->pixels : everyPixel_;
   const std::vector<uint32_t>& offsets = pixels ? pixels->offsets : noOffsets_;
   if (list.empty() || list.size() > pixels_ || offsets.size() != list.size())
     throw Error("internal: a pass of no pixels, of too many, or without an offset for each");
-  const size_t half = shapes_[1].list == 0 ? 1 : 0;
-  lists_[half] = list;  // stable storage for the writes
-  offsets_[half] = offsets;
+  const size_t newerHalf = shapes_[1].list == 0 ? 0 : 1, half = samePixels ? newerHalf : 1 - newerHalf;
+  if (!samePixels) {
+    lists_[half] = list;  // stable storage for the writes
+    offsets_[half] = offsets;
+    FH_CL(dc_.queue.enqueueWriteBuffer(pixelListBuffer_, CL_FALSE, half * pixels_ * 4, list.size() * 4,
+                                       lists_[half].data()));
+    FH_CL(dc_.queue.enqueueWriteBuffer(pixelListBuffer_, CL_FALSE, (2 + half) * pixels_ * 4, list.size() * 4,
+                                       offsets_[half].data()));
+  }
   shapes_[0] = shapes_[1];
-  shapes_[1] = {uint32_t(list.size()), grantedSamples_, uint32_t(local), uint32_t(half * pixels_)};
+  shapes_[1] = {uint32_t(list.size()), uint32_t(grantedSamples_), uint32_t(local), uint32_t(half * pixels_)};
+  shapeStart_ = grantedSamples_;
   shapePixels_[0] = std::move(shapePixels_[1]);
   shapePixels_[1] = std::move(pixels);
-  FH_CL(dc_.queue.enqueueWriteBuffer(pixelListBuffer_, CL_FALSE, half * pixels_ * 4, list.size() * 4,
-                                     lists_[half].data()));
-  FH_CL(dc_.queue.enqueueWriteBuffer(pixelListBuffer_, CL_FALSE, (2 + half) * pixels_ * 4, list.size() * 4,
-                                     offsets_[half].data()));
   FH_CL(dc_.queue.enqueueWriteBuffer(queues_.counters, CL_FALSE, offsetof(gpu::WavefrontCounters, shapes),
                                      sizeof shapes_, shapes_.data()));
 }
@@ -298,12 +307,13 @@ void WavefrontPipeline::newShape(std::shared_ptr<const RoundPixels> pixels, uint
 void WavefrontPipeline::startGrantedPasses() {
   // sampleLimit_ is the source of an asynchronous write: it is set once per batch, after the
   // previous batch's write has completed (readCounters waits for the queue).
-  sampleLimit_ = grantedSamples_;
+  sampleLimit_ = uint32_t(grantedSamples_);
   writeCounter(offsetof(gpu::WavefrontCounters, sample_limit), sampleLimit_);
 }
 
 const gpu::WavefrontCounters& WavefrontPipeline::readCounters() {
   FH_CL(dc_.queue.enqueueReadBuffer(queues_.counters, CL_TRUE, 0, sizeof counters_, &counters_));
+  startedSamples_ += uint32_t(counters_.next_sample - uint32_t(startedSamples_));  // its low 32 bits, which wrap
   for (const auto& [kernel, event] : events_) {
     cl_ulong start = 0, end = 0;
     FH_CL(event.getProfilingInfo(CL_PROFILING_COMMAND_START, &start));
@@ -324,7 +334,7 @@ void WavefrontPipeline::takePass(uint64_t local, std::vector<float>& samples) {
   const size_t aovFloats = surfaceAovs_ ? kAovFloatsPerPixel : 0;
   samples.resize(count * (4 + aovFloats));
   // Its entries, from its first sample's on, in two runs where the ring wraps.
-  const size_t first = passes_[slot].firstSample % passEntries_, before = std::min(count, passEntries_ - first);
+  const size_t first = passes_[slot].table[1], before = std::min(count, passEntries_ - first);
   const std::array<std::array<size_t, 3>, 2> runs{{{first, 0, before}, {0, before, count - before}}};
   for (const auto& [entry, index, length] : runs) {
     if (length == 0) continue;
@@ -343,7 +353,7 @@ void WavefrontPipeline::takePass(uint64_t local, std::vector<float>& samples) {
 RenderStats WavefrontPipeline::stats() {
   auto total64 = [](const uint32_t* pair) { return uint64_t(pair[0]) | uint64_t(pair[1]) << 32; };
   RenderStats st;
-  st.cameraRays = counters_.next_sample;
+  st.cameraRays = startedSamples_ - kFirstLocalSample;
   st.bounceRays = total64(counters_.bounce_rays);
   st.shadowRays = total64(counters_.shadow_rays);
   st.iterations = counters_.iterations;

@@ -84,7 +84,7 @@ class WavefrontPipeline {
   void grantPass(uint64_t local, uint32_t global, std::shared_ptr<const RoundPixels> pixels);
   // Lets the passes granted so far start; once per batch, after its grants.
   void startGrantedPasses();
-  uint32_t globalPass(uint64_t local) const { return passes_[local % FH_MAX_PASS_SLOTS].global; }
+  uint32_t globalPass(uint64_t local) const { return passes_[local % FH_MAX_PASS_SLOTS].table[0]; }
 
   // Waits for the queued iterations and reads the books back.
   const gpu::WavefrontCounters& readCounters();
@@ -120,6 +120,8 @@ class WavefrontPipeline {
   bool launches(Stage s) const;  // whether this strategy launches the stage's own kernel
   void writeCounter(size_t offset, const uint32_t& value);
   void newShape(std::shared_ptr<const RoundPixels> pixels, uint64_t local);
+  // Whether a pass of `size` pixels would take the newer shape past shapeSpan_ samples.
+  bool outgrowsShape(uint32_t size) const { return grantedSamples_ + size - shapeStart_ > shapeSpan_; }
 
   DeviceContext& dc_;
   Method method_;
@@ -136,14 +138,28 @@ class WavefrontPipeline {
   cl::Buffer passBuffers_, filterTable_, passTableBuffer_, pixelListBuffer_;
   bool surfaceAovs_;
   cl::Buffer aovBuffers_;  // per pass entry, kernels/aovs.h (a placeholder without AOVs)
-  // Each local pass in flight, by local pass % FH_MAX_PASS_SLOTS: its global pass (stable
-  // storage for writes), first local sample and pixel count.
+  // Each local pass in flight, by local pass % FH_MAX_PASS_SLOTS: its first local sample,
+  // its pixel count, and its pass-table entry (stable storage for writes): its global pass
+  // and its first entry in the pass buffers.
   struct PassInFlight {
-    uint32_t global = 0, firstSample = 0, pixels = 0;
+    uint64_t firstSample = 0;
+    uint32_t pixels = 0;
+    uint32_t table[2] = {0, 0};
   };
   std::vector<PassInFlight> passes_;
-  uint32_t grantedSamples_ = 0;  // local samples of the passes granted so far
-  uint32_t sampleLimit_ = 0;     // what the device may start: stable storage for writes
+  // Local samples are counted here in 64 bits and numbered on the device by the low 32 bits
+  // of the count, which wrap (a device renders more than 2^32 samples of a large image):
+  // the kernels only take differences of numbers less than 2^31 apart. The count starts
+  // just short of 2^32, so that every render of more than 256 samples crosses the wrap (as
+  // Linux's jiffies start just short of theirs), and the tests see it.
+  static constexpr uint64_t kFirstLocalSample = (uint64_t(1) << 32) - 256;
+  uint64_t grantedSamples_ = kFirstLocalSample;  // local samples of the passes granted so far
+  uint64_t startedSamples_ = kFirstLocalSample;  // local samples started, as of readCounters()
+  uint32_t sampleLimit_ = 0;                     // what the device may start: stable storage for writes
+  // The newer shape's first local sample, and the most samples a shape's passes span: a
+  // longer run of passes over the same pixels is a new shape of them (the sample's place in
+  // its shape, kernels/generate.cl, stays far below 2^32).
+  uint64_t shapeStart_ = kFirstLocalSample, shapeSpan_ = 0;
   // The two shapes of WavefrontCounters (stable storage for writes) and the pixel lists
   // they cover (null: every pixel, listed in everyPixel_, offsets 0); a shape's list is in
   // the half of the pixel-list buffer at its `list`, its sequence offsets two halves on.
