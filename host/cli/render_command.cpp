@@ -114,8 +114,7 @@ unsigned parseSeed(const std::string& text) {
 }
 
 // Every flag that does not need the scene, checked; 64 spp by default (4 for --aov), or
-// with --time or --noise and no --spp as many as they take (a render numbers its samples in
-// 32 bits, so at most that many).
+// with --time or --noise and no --spp as many as they take (up to 2^20, whatever the image).
 RenderSettings settingsFrom(const RenderOptions& o) {
   RenderSettings s;
   s.method = parseMethod(o.method);
@@ -135,12 +134,9 @@ RenderSettings settingsFrom(const RenderOptions& o) {
   if (o.maxDepth < 1) throw Error("--max-depth must be at least 1");
   if (o.rrDepth < 1) throw Error("--rr-depth must be at least 1");
   if (o.wavefront && *o.wavefront < kLocalSize) throw Error("--wavefront must be at least 64");
-  const uint64_t pixels = uint64_t(o.width) * uint64_t(o.height);
   s.width = o.width;
   s.height = o.height;
-  s.spp = o.spp ? *o.spp
-                : (o.seconds > 0 || o.noise > 0 ? int(std::min<uint64_t>(1 << 20, 0xFFFFFFFFull / pixels))
-                                 : (o.aov.empty() ? 64 : 4));
+  s.spp = o.spp ? *o.spp : (o.seconds > 0 || o.noise > 0 ? 1 << 20 : (o.aov.empty() ? 64 : 4));
   if (!o.passes.empty()) chunkOf(o, s);
   s.seconds = o.seconds;
   s.noise = o.noise;

@@ -15,11 +15,12 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// The passes a render may number: global sample pass * pixels + pixel is 32 bits (an
-// adaptive render's passes cover fewer pixels, so it may have more than spp of them).
+// The passes a render may number: spp, or for an adaptive render, whose passes cover fewer
+// pixels, as many as its sample budget takes, up to the last whole round that 32-bit pass
+// numbers hold (a pass and the pixel seed a sample apart, kernels/sampler.h, so passes of
+// any image may go that far).
 uint32_t passLimit(const RenderSettings& s) {
-  return s.adaptive ? uint32_t(0xFFFFFFFFull / (uint64_t(s.width) * uint64_t(s.height)))
-                    : uint32_t(std::max(1, s.spp));
+  return s.adaptive ? uint32_t(0) - 2 * kAdaptiveLongestRound : uint32_t(std::max(1, s.spp));
 }
 }  // namespace
 
