@@ -373,6 +373,66 @@ TEST(PathTracer, DeterministicForASeedWhateverTheWavefront) {
   EXPECT_NE(a.film.sum, c.film.sum);
 }
 
+// Passes whose samples number past 2^32 in one render (pass * pixels + pixel: 4K at 1024
+// spp, 8K at 65536) are samples of their own: a sample is seeded by its pixel and its point
+// in the pixel's sequence apart, never by one 32-bit sample number. A 16x16 image's passes
+// around P = 2^32 / 256, where pass * pixels + pixel would wrap onto the samples of passes
+// 0, 1, ...: a chunk of them, which straddles 2^32 samples (the devices' own sample numbers
+// wrap too, render/wavefront.h), is the same bits rendered again and rendered as two
+// chunks merged, follows Lambert's formula, and is not the chunk of passes 0, 1, ...
+TEST_P(EveryMethod, PassesPastTwoToTheThirtyTwoSamplesAreSamplesOfTheirOwn) {
+  const Scene scene = PlaneUnderLight::scene();
+  const Bvh bvh = buildBvh(scene);
+  const int size = 16;
+  const uint32_t pixels = uint32_t(size * size), wrap = uint32_t((uint64_t(1) << 32) / pixels), half = 32;
+  const auto chunk = [&](uint32_t first, uint32_t end) {
+    RenderSettings s = test::renderSettings();
+    s.width = s.height = size;
+    s.method = GetParam();
+    s.firstPass = first;
+    s.spp = int(end);
+    return fh::render(test::defaultDevice(), scene, bvh, scene.camera, s);
+  };
+  const std::string what = methodName(GetParam());
+  const RenderResult whole = chunk(wrap - half, wrap + half);
+  ASSERT_TRUE(whole.complete) << what;
+  EXPECT_EQ(whole.film.firstPass(), wrap - half) << what;
+  EXPECT_EQ(whole.film.passes(), 2u * half) << what;
+  EXPECT_EQ(whole.stats.samples, uint64_t(pixels) * 2 * half) << what;
+  EXPECT_EQ(whole.stats.cameraRays, whole.stats.samples) << what;
+  EXPECT_EQ(whole.stats.nonfinite, 0u) << what;
+
+  // Deterministic, and the same bits from chunks split where the samples pass 2^32.
+  const RenderResult again = chunk(wrap - half, wrap + half);
+  EXPECT_TRUE(again.film.sum == whole.film.sum) << what << ": rendered again, the bits differ";
+  EXPECT_TRUE(again.film.sumSq == whole.film.sumSq) << what;
+  const RenderResult below = chunk(wrap - half, wrap), above = chunk(wrap, wrap + half);
+  Film merged = below.film;
+  merged.merge(above.film);
+  EXPECT_TRUE(merged.sum == whole.film.sum) << what << ": two chunks merged differ from one";
+
+  // Unbiased: the closed form within the render's own variance (expectMatches: the image
+  // mean within 4 sigma, and 4x4 blocks within 3.29 sigma but for 5 % of them).
+  const Image exact = PlaneUnderLight::reference(scene.camera, size, size, 8, true);
+  expectMatches(whole.film, [&](size_t p) { return double(exact.rgb[3 * p]); }, what + " past 2^32 samples");
+
+  // Not the samples of passes 0, 1, ..., which wrapping sample numbers would give again
+  // (the same bits): most pixels whose samples vary have other sums. Not all: where a
+  // sample takes one of a few values (at the light's edges; pt's paths find the light or
+  // not), stratified samples often find it as many times.
+  const RenderResult start = chunk(0, half);
+  EXPECT_FALSE(start.film.sum == above.film.sum) << what << ": passes from " << wrap << " repeat passes 0..";
+  size_t varying = 0, other = 0;
+  for (size_t p = 0; p < start.film.pixels(); ++p) {
+    if (pixelVariance(start.film, p) <= 0) continue;  // sees the light alone, or nothing
+    ++varying;
+    other += !std::equal(&start.film.sum[4 * p], &start.film.sum[4 * p + 3], &above.film.sum[4 * p]);
+  }
+  ASSERT_GT(varying, size_t(pixels / 4)) << what;
+  EXPECT_GT(other, varying / 2) << what << ": of " << varying << " pixels, " << varying - other
+                                << " have the same sums in passes from " << wrap << " as in passes 0..";
+}
+
 TEST(PathTracer, NoNonFiniteSamplesOnAnyCorpusScene) {
   for (const char* path :
        {"cornell-box/CornellBox-Original.obj", "cornell-box/CornellBox-Empty-CO.obj",
