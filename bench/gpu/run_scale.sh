@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Renders past 2^32 samples on a GPU machine: the Cornell box at 3840x2160 with 1024 spp and
-# at 1920x1080 with 4096 spp (8.5e9 samples each), with the seconds each took, the host's
-# peak memory (/usr/bin/time -v where the machine has it) and each image's channel means.
+# Renders past 2^32 samples on a GPU machine: the Cornell box at 3840x2160 with 1024 spp, at
+# 1920x1080 with 4096 spp and at 7680x4320 with 256 spp (8.5e9 samples each), with the
+# seconds each took, the host's peak memory (/usr/bin/time -v where the machine has it) and each image's channel means.
 #
 #   bench/gpu/run_scale.sh [--small] FREDHOLM OUTDIR
 #
@@ -29,7 +29,7 @@ if fh 60 devices --device gpu; then gpu=gpu; else gpu=0; fi
 if [ $small -eq 1 ]; then
   sizes=("64 36 4" "32 18 16")
 else
-  sizes=("3840 2160 1024" "1920 1080 4096")
+  sizes=("3840 2160 1024" "1920 1080 4096" "7680 4320 256")
 fi
 timer=()
 [ -x /usr/bin/time ] && timer=(/usr/bin/time -v)
