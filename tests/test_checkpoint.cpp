@@ -7,8 +7,11 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -84,7 +87,8 @@ TEST(Checkpoint, OtherSettingsOrADamagedFileAreRefused) {
   std::string header;
   std::getline(std::ifstream(ckpt), header);
   const std::string fingerprint = header.substr(header.find(' ') + 1, 16);
-  test::writeFile(dir + "/huge.fhc", "fredholm-film-4 " + fingerprint + " 16384 16384 1 0 3 0 0 0 0\n0123");
+  test::writeFile(dir + "/huge.fhc",
+                  resealFilm("fredholm-film-5 " + fingerprint + " 16384 16384 1 0 3 0 0 0 0 - - - - - - -\n0123"));
   const auto huge = test::runFredholm(kRender + " --resume " + dir + "/huge.fhc -o " + dir + "/e.exr");
   EXPECT_EQ(huge.exitCode, 1);
   EXPECT_NE(huge.output.find("cut short"), std::string::npos) << huge.output;
@@ -93,6 +97,127 @@ TEST(Checkpoint, OtherSettingsOrADamagedFileAreRefused) {
   EXPECT_EQ(junk.exitCode, 1);
   EXPECT_NE(junk.output.find("not a fredholm film or checkpoint"), std::string::npos) << junk.output;
   for (const char* f : {"/b.exr", "/c.exr", "/d.exr"}) EXPECT_FALSE(std::filesystem::exists(dir + f)) << f;
+}
+
+// A film with every section a film file has: sums, sums of squares, surface layers, the odd
+// passes' sums and both adaptive pixel lists.
+Film everySectionFilm() {
+  constexpr int kW = 5, kH = 3, kPixels = kW * kH;
+  Film film(kW, kH, true, true);
+  for (int pass = 0; pass < 4; ++pass) {
+    std::vector<float> samples;
+    for (int p = 0; p < kPixels; ++p) samples.insert(samples.end(), {0.1f * float(p), 0.5f, 1.f + float(pass), 1.f});
+    for (int p = 0; p < kPixels; ++p)
+      samples.insert(samples.end(), {0.5f, 0.25f, 0.125f, 1.f, 0.f, 1.f, 0.f, 2.f + float(p)});
+    film.addPass(samples);
+  }
+  film.roundPixels = std::make_shared<const std::vector<uint32_t>>(std::vector<uint32_t>{0, 3, 7, 14});
+  film.nextRoundPixels = std::make_shared<const std::vector<uint32_t>>(std::vector<uint32_t>{1, 2, 3});
+  return film;
+}
+
+std::string fileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// A flipped byte anywhere in a film file (its header, each sum array, each pixel list), by
+// one bit, the top bit or all eight: the file is refused, naming it and, past the header, the
+// section that does not match its checksum.
+TEST(Checkpoint, AFlippedByteInAnySectionIsRefused) {
+  const std::string dir = test::tempDir("flip");
+  const std::string saved = dir + "/every.film", flipped = dir + "/flipped.film";
+  const Film film = everySectionFilm();
+  saveFilm(saved, film, "0123456789abcdef", "--film");
+  ASSERT_EQ(readFilm(saved, "merge").film.sum, film.sum);
+  const std::string bytes = fileBytes(saved);
+  const size_t pixels = film.pixels();
+  struct Section {
+    std::string message;  // what the refusal says, past the header
+    size_t size;
+  };
+  const std::vector<Section> sections = {{"", bytes.find('\n') + 1},
+                                         {"the film's sums are corrupt", 4 * pixels * 8},
+                                         {"the film's sums of squares are corrupt", 4 * pixels * 8},
+                                         {"the film's surface layer sums are corrupt", kAovSumsPerPixel * pixels * 8},
+                                         {"the film's odd passes' sums are corrupt", kOddSumsPerPixel * pixels * 8},
+                                         {"the film's round pixel list is corrupt", 4 * 4},
+                                         {"the film's next round pixel list is corrupt", 3 * 4}};
+  size_t begin = 0;
+  for (const Section& section : sections) {
+    for (const size_t at : {begin, begin + 1, begin + section.size / 3, begin + section.size / 2,
+                            begin + section.size - 2, begin + section.size - 1})
+      for (const unsigned char mask : {0x01, 0x80, 0xff}) {
+        std::string damaged = bytes;
+        damaged[at] = char(damaged[at] ^ mask);
+        test::writeFile(flipped, damaged);
+        const std::string where = "byte " + std::to_string(at) + " ^ " + std::to_string(mask);
+        try {
+          readFilm(flipped, "merge");
+          ADD_FAILURE() << where << " (" << (section.message.empty() ? "header" : section.message) << "): accepted";
+        } catch (const Error& e) {
+          const std::string message = e.what();
+          EXPECT_EQ(message.rfind("merge '" + flipped + "': ", 0), 0u) << where << ": " << message;
+          EXPECT_EQ(message.find('\n'), std::string::npos) << where << ": " << message;
+          if (!section.message.empty()) {
+            EXPECT_NE(message.find(section.message + " (checksum mismatch)"), std::string::npos)
+                << where << ": " << message;
+          }
+        }
+      }
+    begin += section.size;
+  }
+  EXPECT_EQ(begin, bytes.size());
+}
+
+// A value that must be finite and is not, in a film whose checksums hold (saved so): refused.
+TEST(Checkpoint, ANonFiniteSumIsRefusedThoughItsChecksumHolds) {
+  const std::string dir = test::tempDir("non-finite");
+  for (const double bad : {-double(INFINITY), double(NAN)}) {
+    for (int array = 0; array < 4; ++array) {
+      Film film = everySectionFilm();
+      std::vector<double>& sums = array == 0 ? film.sum : array == 1 ? film.sumSq : array == 2 ? film.aovSum : film.oddSum;
+      sums[5] = bad;
+      saveFilm(dir + "/bad.film", film, "0123456789abcdef", "--film");
+      try {
+        readFilm(dir + "/bad.film", "--resume");
+        ADD_FAILURE() << "array " << array << " holding " << bad << ": accepted";
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("--resume '" + dir + "/bad.film': the film's "), std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("not finite"), std::string::npos) << e.what();
+      }
+    }
+  }
+}
+
+// Through the command line: merge and --resume refuse a film with a flipped byte, in one
+// line naming the file and what is corrupt, and write nothing.
+TEST(Checkpoint, MergeAndResumeRefuseAFlippedByte) {
+  const std::string dir = test::tempDir("flip-cli");
+  ASSERT_EQ(test::runFredholm(kRender + " --checkpoint " + dir + "/c.fhc -o " + dir + "/a.exr").exitCode, 0);
+  ASSERT_EQ(test::runFredholm("render --width 24 --height 24 --seed 3 --passes 0:4 --film " + dir + "/p.film").exitCode, 0);
+  for (const char* name : {"/c.fhc", "/p.film"}) {
+    std::string bytes = fileBytes(dir + name);
+    const size_t at = bytes.find('\n') + 1 + 8 * 13 + 7;  // the top byte of a sum
+    bytes[at] = char(bytes[at] ^ 0x80);
+    test::writeFile(dir + name + ".bad", bytes);
+  }
+  const std::string damaged = "the film's sums are corrupt (checksum mismatch)";
+  const auto resumed = test::runFredholm(kRender + " --resume " + dir + "/c.fhc.bad -o " + dir + "/r.exr");
+  EXPECT_EQ(resumed.exitCode, 1) << resumed.output;
+  EXPECT_NE(resumed.output.find("fredholm: error: --resume '" + dir + "/c.fhc.bad': " + damaged), std::string::npos)
+      << resumed.output;
+  const auto merged = test::runFredholm("merge " + dir + "/p.film.bad -o " + dir + "/m.exr");
+  EXPECT_EQ(merged.exitCode, 1) << merged.output;
+  EXPECT_NE(merged.output.find("fredholm: error: merge '" + dir + "/p.film.bad': " + damaged), std::string::npos)
+      << merged.output;
+  for (const auto* r : {&resumed, &merged}) {
+    const size_t line = r->output.find("fredholm: error: ");
+    EXPECT_TRUE(line != std::string::npos && r->output.find('\n', line) + 1 == r->output.size()) << r->output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/r.exr"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/m.exr"));
 }
 
 // Ctrl-C: the image so far and the checkpoint are written, and resuming finishes the image
@@ -213,7 +338,7 @@ TEST(Chunks, OverlapsOtherRendersGapsAndBadFlagsAreCaught) {
   for (const Case& c : std::vector<Case>{
            {"merge " + dir + "/p0.film " + dir + "/p2.film -o " + dir + "/x.exr", "shares passes"},
            {"merge " + dir + "/p0.film " + dir + "/other.film -o " + dir + "/x.exr", "a chunk of another render"},
-           {"merge " + dir + "/p0.film " + dir + "/missing.film -o " + dir + "/x.exr", "cannot read"},
+           {"merge " + dir + "/p0.film " + dir + "/missing.film -o " + dir + "/x.exr", "missing.film': file not found"},
            {"merge " + dir + "/p0.film", "missing --output (Output image"},
            {render + "--passes 4:4 --film " + dir + "/e.film", "0 <= A < B"},
            {render + "--passes -1:4 --film " + dir + "/e.film", "0 <= A < B"},

@@ -26,9 +26,16 @@ std::string renderFingerprint(const Scene& scene, const Camera& camera, const Re
 std::string saveFilm(const std::string& path, const Film& film, const std::string& fingerprint, const std::string& flag);
 void saveCheckpoint(const std::string& path, const Film& film, const std::string& fingerprint);
 
+// The bytes of a film file with every checksum its header gives made anew over the sections
+// as the header lays them out (those cut short: over what there is): for the fuzzer, whose
+// mutations would otherwise stop at the first checksum, and tests that write a header by
+// hand. Bytes whose first line is not a film header come back as they are.
+std::string resealFilm(const std::string& bytes);
+
 // A film file as saved: the film (its first pass and pass count included) and the
 // fingerprint of the render that saved it. Throws fh::Error naming `flag` and the file if
-// it cannot be read, is cut short or is not consistent.
+// it cannot be read (not a regular file: base/input_file.h), is cut short, fails a section's
+// checksum (a byte changed since it was saved) or is not consistent.
 struct SavedFilm {
   Film film;
   std::string fingerprint;
