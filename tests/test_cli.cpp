@@ -29,7 +29,7 @@ TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
       {"--max-depth 0", "--max-depth must be at least 1"},
       {"--fov 0", "--fov: vertical field of view must lie in (0, 180) degrees"},
       {"--width 100000 --height 100000", "is more than the 268 million pixels"},
-      {"--camera /nonexistent/cam.json", "cannot open camera file"},
+      {"--camera /nonexistent/cam.json", "--camera '/nonexistent/cam.json': file not found"},
       {"/nonexistent/scene.obj", "scene '/nonexistent/scene.obj': file not found"},
       // Issue 17, rows 9-11 and 17.
       {"--env=-1,0,0", "--env '-1,0,0': radiance cannot be negative"},

@@ -349,7 +349,7 @@ TEST(EnvironmentMapCli, RendersFromExrAndHdrAndRejectsBadInput) {
     std::string args, message;
   };
   for (const Bad& bad : std::vector<Bad>{
-           {"--env-map '" + dir + "/missing.exr'", "--env-map: cannot read"},
+           {"--env-map '" + dir + "/missing.exr'", "--env-map '" + dir + "/missing.exr': file not found"},
            {"--env-map '" + dir + "/sky.png'", "must be an .exr or .hdr"},
            {"--env-rotate 10", "--env-rotate applies to --env-map"},
            {"--env-scale 2", "--env-scale applies to --env-map"},

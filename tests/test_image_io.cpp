@@ -1,10 +1,17 @@
 // Image output: formats by extension, round trips, metadata, and the checks made before
-// rendering (unknown extension, unwritable path, no overwrite without --force).
+// rendering (unknown extension, unwritable path, no overwrite without --force). Input: every
+// file fredholm reads goes through one gate (devices, FIFOs and headers that lie are refused
+// in one line naming the file and its role).
 #include <gtest/gtest.h>
 
 #include <OpenImageIO/imageio.h>
 
+#include <sys/stat.h>
+
+#include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <vector>
 
 #include "base/error.h"
 #include "image/error_metrics.h"
@@ -104,6 +111,112 @@ TEST(ImageIoCli, DefaultNameStepsAside) {
   EXPECT_NE(second.output.find("wrote fredholm-1.png"), std::string::npos) << second.output;
   EXPECT_TRUE(std::filesystem::exists(dir + "/fredholm.png"));
   EXPECT_TRUE(std::filesystem::exists(dir + "/fredholm-1.png"));
+}
+
+// A PNG of 66 bytes whose header claims `width` x `height` RGB pixels: the signature, IHDR,
+// an IDAT of one deflated byte and IEND, each chunk with its CRC-32 (PNG's, not fredholm's).
+std::string lyingPng(uint32_t width, uint32_t height) {
+  const auto crc32 = [](const std::string& bytes) {
+    uint32_t c = 0xffffffffu;
+    for (unsigned char b : bytes) {
+      c ^= b;
+      for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
+    }
+    return c ^ 0xffffffffu;
+  };
+  const auto be32 = [](uint32_t v) {
+    return std::string{char(v >> 24), char(v >> 16 & 0xff), char(v >> 8 & 0xff), char(v & 0xff)};
+  };
+  const auto chunk = [&](const std::string& type, const std::string& data) {
+    return be32(uint32_t(data.size())) + type + data + be32(crc32(type + data));
+  };
+  const std::string ihdr = be32(width) + be32(height) + std::string("\x08\x02\x00\x00\x00", 5);  // 8-bit RGB
+  return std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", ihdr) +
+         chunk("IDAT", std::string("\x78\x9c\x63\x00\x00\x00\x01\x00\x01", 9)) + chunk("IEND", "");
+}
+
+// What a CLI run printed is one line: `fredholm: error: ` and `message`, and nothing else.
+void expectOneErrorLine(const test::CommandResult& r, const std::string& message, const std::string& what) {
+  EXPECT_EQ(r.exitCode, 1) << what << "\n" << r.output;
+  EXPECT_EQ(r.output, "fredholm: error: " + message + "\n") << what;
+}
+
+// A device (/dev/zero never ends) or a FIFO (opening it waits for a writer) in any role is
+// refused at once, in one line naming the role and the file: before the gate, --resume and
+// merge read /dev/zero until memory ran out and a FIFO as --camera hung. Each run is killed
+// after 60 s, so that a hang fails the test rather than blocking it.
+TEST(InputGateCli, DevicesAndFifosAreRefusedInOneLine) {
+  const std::string dir = test::tempDir("gate");
+  std::filesystem::create_symlink("/dev/zero", dir + "/zero.exr");
+  ASSERT_EQ(::mkfifo((dir + "/camera.fifo").c_str(), 0600), 0);
+  writeImage(dir + "/ok.exr", gradient(4, 4), {});
+  const std::string render = "render --width 8 --height 8 --spp 1 -o " + dir + "/out.png ";
+  struct Case {
+    std::string args, what, path;
+  };
+  for (const Case& c : std::vector<Case>{{render + "--camera /dev/zero", "--camera", "/dev/zero"},
+                                         {render + "--camera " + dir + "/camera.fifo", "--camera", dir + "/camera.fifo"},
+                                         {render + "--resume /dev/zero", "--resume", "/dev/zero"},
+                                         {"merge /dev/zero -o " + dir + "/m.exr", "merge", "/dev/zero"},
+                                         {"compare /dev/zero " + dir + "/ok.exr", "compare", "/dev/zero"},
+                                         {"compare " + dir + "/ok.exr " + dir + "/zero.exr", "compare", dir + "/zero.exr"},
+                                         {render + "--env-map " + dir + "/zero.exr", "--env-map", dir + "/zero.exr"}}) {
+    const auto r = test::runFredholm(c.args, "timeout -s KILL 60");
+    expectOneErrorLine(r, c.what + " '" + c.path + "': is not a regular file (a device, FIFO or socket); give a file",
+                       c.args);
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/m.exr"));
+}
+
+// An image whose header claims 100000x100000 pixels in 66 bytes is refused before anything
+// is allocated for it, naming the file and the size claimed (it was std::bad_alloc, exit 3).
+TEST(InputGate, AnImageHeaderClaimingMoreThanItsFileHoldsIsRefused) {
+  const std::string path = test::tempDir("gate") + "/huge.png";
+  test::writeFile(path, lyingPng(100000, 100000));
+  ASSERT_EQ(std::filesystem::file_size(path), 66u);
+  try {
+    readImage(path, "compare");
+    FAIL() << "read";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "compare '" + path + "': its header claims 100000x100000x3 pixels, more than the " +
+                                         std::to_string(kMaxImagePixels) + " fredholm reads");
+  }
+  // Within fredholm's limit but not within 66 bytes.
+  test::writeFile(path, lyingPng(8000, 8000));
+  try {
+    readImage(path, "--env-map");
+    FAIL() << "read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--env-map '" + path + "': its header claims 8000x8000x3 pixels, more than its 66 bytes"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// The same PNG as a texture: a warning naming the material, the file and the size claimed,
+// and the render goes on with a grey texel, as for any texture that cannot be decoded.
+TEST(InputGateCli, ATextureWhoseHeaderLiesIsAWarningNamingItsClaim) {
+  const std::string dir = test::tempDir("gate");
+  test::writeFile(dir + "/t.obj", "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                                  "usemtl painted\nf 1/1 2/2 3/3\n");
+  test::writeFile(dir + "/t.mtl", "newmtl painted\nKd 0.5 0.5 0.5\nKe 1 1 1\nmap_Kd huge.png\n");
+  test::writeFile(dir + "/huge.png", lyingPng(100000, 100000));
+  const auto r = test::runFredholm("render " + dir + "/t.obj --width 8 --height 8 --spp 1 --eye 0.3,0.3,2 "
+                                   "--target 0.3,0.3,0 -o " + dir + "/t.pfm",
+                                   "timeout -s KILL 120");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("fredholm: warning: material 'painted': texture '" + dir +
+                          "/huge.png': its header claims 100000x100000x3 pixels, more than the " +
+                          std::to_string(kMaxImagePixels) + " fredholm reads; using a grey texel\n"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("bad_alloc"), std::string::npos) << r.output;
+  const auto compared = test::runFredholm("compare " + dir + "/huge.png " + dir + "/t.pfm", "timeout -s KILL 60");
+  expectOneErrorLine(compared,
+                     "compare '" + dir + "/huge.png': its header claims 100000x100000x3 pixels, more than the " +
+                         std::to_string(kMaxImagePixels) + " fredholm reads",
+                     "compare");
 }
 
 }  // namespace

@@ -38,10 +38,8 @@ int runDevices(const std::string& spec) {
 }
 
 int runCompare(const CompareOptions& o) {
-  for (const std::string* path : {&o.image, &o.reference})
-    if (!std::filesystem::is_regular_file(*path)) throw Error(*path + ": image not found");
   if (o.block < 1) throw Error("--block must be at least 1");
-  Image image = readImage(o.image), reference = readImage(o.reference);
+  Image image = readImage(o.image, "compare"), reference = readImage(o.reference, "compare");
   if (o.block > 1) {
     try {
       image = blockAverage(image, o.block);

@@ -16,6 +16,7 @@
 
 #include "base/atomic_file.h"
 #include "base/error.h"
+#include "base/input_file.h"
 
 namespace fh {
 namespace {
@@ -36,29 +37,32 @@ void writePfm(const std::string& path, const Image& image) {
   if (!out) throw Error("the write failed (disk full?)");
 }
 
-Image readPfm(const std::string& path) {
+#ifndef FREDHOLM_HAVE_OIIO
+Image readPfm(const std::string& path, const std::string& what) {
+  const std::string named = what + " '" + path + "': ";
+  checkInputFile(path, what);
   std::ifstream in(path, std::ios::binary);
   std::string magic;
   Image image;
   double scale = 0.0;
   if (!(in >> magic >> image.width >> image.height >> scale) || magic != "PF" || image.width <= 0 ||
       image.height <= 0 || scale >= 0.0 || image.width > (1 << 16) || image.height > (1 << 16))
-    throw Error("cannot read '" + path + "': not a little-endian RGB PFM file");
+    throw Error(named + "not a little-endian RGB PFM file");
   in.get();  // the single whitespace byte before the pixels
   // The pixels must be in the file before they are allocated (a header can claim 4G pixels).
   const auto start = in.tellg();
   in.seekg(0, std::ios::end);
   const auto bytes = static_cast<long long>(in.tellg() - start);
   in.seekg(start);
-  if (bytes < static_cast<long long>(image.width) * image.height * 12)
-    throw Error("cannot read '" + path + "': file ends early");
+  if (bytes < static_cast<long long>(image.width) * image.height * 12) throw Error(named + "the file ends early");
   image.rgb.resize(size_t(image.width) * size_t(image.height) * 3);
   for (int y = image.height - 1; y >= 0; --y)
     in.read(reinterpret_cast<char*>(&image.rgb[size_t(y) * size_t(image.width) * 3]),
             std::streamsize(size_t(image.width) * 3 * sizeof(float)));
-  if (!in) throw Error("cannot read '" + path + "': file ends early");
+  if (!in) throw Error(named + "the file ends early");
   return image;
 }
+#endif
 
 }  // namespace
 
@@ -194,7 +198,7 @@ void checkComplete(const std::string& path, const Image& image) {
   }
   Image back;
   try {
-    back = readImage(path);
+    back = readImage(path, "image");
   } catch (const Error&) {
     throw Error("the file written does not decode (disk full?)");
   }
@@ -212,9 +216,19 @@ std::string writeImage(const std::string& path, const Image& image,
       [&](const std::string& temp) { checkComplete(temp, image); });
 }
 
+namespace {
+
+// A message of one line: OpenImageIO's errors may run over several.
+std::string oneLine(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  for (size_t at; (at = text.find('\n')) != std::string::npos;) text.replace(at, 1, "; ");
+  return text.empty() ? "no reason given" : text;
+}
+
+#ifdef FREDHOLM_HAVE_OIIO
 // A PNG's chunks must fit in its file: libpng allocates what a chunk's header claims before
 // reading it (a text chunk claiming 1.7 GB in a 600-byte file, found by fuzzing).
-void checkPngChunks(const std::string& path) {
+void checkPngChunks(const std::string& path, const std::string& what) {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   const long long size = static_cast<long long>(in.tellg());
   in.seekg(8);  // the signature
@@ -223,38 +237,45 @@ void checkPngChunks(const std::string& path) {
     if (!in.read(reinterpret_cast<char*>(header), 8)) return;
     const long long length = (static_cast<long long>(header[0]) << 24) | (header[1] << 16) | (header[2] << 8) | header[3];
     if (at + 12 + length > size)
-      throw Error("cannot read '" + path + "': a PNG chunk claims " + std::to_string(length) +
+      throw Error(what + " '" + path + "': a PNG chunk claims " + std::to_string(length) +
                   " bytes, more than the file holds");
     if (std::string(reinterpret_cast<char*>(header) + 4, 4) == "IEND") return;
     at += 12 + length;
     in.seekg(at);
   }
 }
+#endif
 
-Image readImage(const std::string& path) {
-#ifndef FREDHOLM_HAVE_OIIO
-  return readPfm(path);
-#else
-  if (extensionOf(path) == ".png") checkPngChunks(path);
+}  // namespace
+
+#ifdef FREDHOLM_HAVE_OIIO
+std::unique_ptr<OIIO::ImageInput> openImageInput(const std::string& path, const std::string& what) {
+  const uint64_t fileBytes = checkInputFile(path, what);
+  if (extensionOf(path) == ".png") checkPngChunks(path, what);
   auto in = OIIO::ImageInput::open(path);
-  if (!in) throw Error("cannot read '" + path + "': " + OIIO::geterror());
+  if (!in) throw Error(what + " '" + path + "': cannot read it as an image (" + oneLine(OIIO::geterror()) + ")");
   const OIIO::ImageSpec& spec = in->spec();
-  // As many pixels as fredholm renders at most, and no more than the file can hold: no
-  // format fredholm writes compresses a pixel below a thousandth of a byte, and a header
+  // No format fredholm reads compresses a pixel below a thousandth of a byte: a header
   // claiming more would have the reader allocate and decode gigabytes of nothing.
-  std::error_code ec;
-  const uint64_t fileBytes = uint64_t(fs::file_size(path, ec)), count = uint64_t(spec.width) * uint64_t(spec.height);
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.nchannels > 64 ||
-      count > (uint64_t(1) << 28) || count > 1024 * fileBytes + 65536)
-    throw Error("cannot read '" + path + "': " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                "x" + std::to_string(spec.nchannels) + " is not an image fredholm compares (" +
-                std::to_string(fileBytes) + " bytes)");
+  checkImageClaim(path, what, spec.width, spec.height, spec.nchannels, fileBytes, kMaxImagePixels);
+  if (spec.depth > 1 || spec.deep)
+    throw Error(what + " '" + path + "': a volume or deep image, not a flat one");
+  return in;
+}
+#endif
+
+Image readImage(const std::string& path, const std::string& what) {
+#ifndef FREDHOLM_HAVE_OIIO
+  return readPfm(path, what);
+#else
+  const auto in = openImageInput(path, what);
+  const OIIO::ImageSpec& spec = in->spec();
   Image image;
   image.width = spec.width;
   image.height = spec.height;
   std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
   if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data()))
-    throw Error("cannot read '" + path + "': " + in->geterror());
+    throw Error(what + " '" + path + "': cannot decode it (" + oneLine(in->geterror()) + ")");
   const bool srgb = spec.format == OIIO::TypeDesc::UINT8;
   image.rgb.resize(size_t(spec.width) * size_t(spec.height) * 3);
   for (size_t p = 0; p < size_t(spec.width) * size_t(spec.height); ++p)

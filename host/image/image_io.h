@@ -1,10 +1,19 @@
-// Writing the film through OpenImageIO. The format follows the extension: .exr as linear
-// float with the render settings in its metadata, .hdr/.pfm as float, .png/.jpg as sRGB
-// 8-bit. Row 0 is the top of the image.
+// Images through OpenImageIO: writing the film, and the one way fredholm opens an image it
+// reads. The format follows the extension: .exr as linear float with the render settings in
+// its metadata, .hdr/.pfm as float, .png/.jpg as sRGB 8-bit. Row 0 is the top of the image.
 #pragma once
+#include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
+
+#ifdef FREDHOLM_HAVE_OIIO
+#include <OpenImageIO/oiioversion.h>
+OIIO_NAMESPACE_BEGIN
+class ImageInput;
+OIIO_NAMESPACE_END
+#endif
 
 namespace fh {
 
@@ -45,7 +54,22 @@ std::string firstFreeName(const std::string& path);
 // Writes the image whole or not at all (base/atomic_file.h); returns the path written.
 std::string writeImage(const std::string& path, const Image& image, const std::map<std::string, std::string>& metadata);
 
-Image readImage(const std::string& path);  // linear float RGB (tests)
+// The most pixels fredholm reads of one image (an 8K image has 2^25): a header claiming more
+// is refused before anything is allocated for it.
+constexpr uint64_t kMaxImagePixels = uint64_t(1) << 28;
+
+#ifdef FREDHOLM_HAVE_OIIO
+// Every image fredholm reads (compare's, textures, environment maps) is opened here: the file
+// through the input gate (base/input_file.h: a regular file within the size cap, a PNG's chunks
+// within the file), then its header's claim (width x height x channels, a flat image) against
+// the file's size and kMaxImagePixels, so that reading its pixels allocates no more than the
+// file can hold. `what` is the file's role ("compare", "texture", "--env-map"); errors are one
+// line, "WHAT 'PATH': why".
+std::unique_ptr<OIIO::ImageInput> openImageInput(const std::string& path, const std::string& what);
+#endif
+
+// The image at `path` (opened by openImageInput) as linear float RGB; errors name `what`.
+Image readImage(const std::string& path, const std::string& what = "image");
 
 float linearToSrgb(float linear);
 float srgbToLinear(float encoded);

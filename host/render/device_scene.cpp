@@ -142,10 +142,9 @@ std::vector<uint32_t> srgbDecodeTable() {
 
 TextureData loadTexture(const std::string& path) {
 #ifndef FREDHOLM_HAVE_OIIO
-  throw Error(path + ": cannot read texture (this build has no OpenImageIO)");
+  throw Error("texture '" + path + "': cannot read it (this build has no OpenImageIO)");
 #else
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw Error(path + ": cannot read texture (" + OIIO::geterror() + ")");
+  const auto in = openImageInput(path, "texture");
   const OIIO::ImageSpec& spec = in->spec();
   const int channels = spec.nchannels;
   const size_t texels = size_t(spec.width) * size_t(spec.height);
@@ -156,7 +155,7 @@ TextureData loadTexture(const std::string& path) {
   if (spec.format.basetype == OIIO::TypeDesc::UINT8) {
     std::vector<unsigned char> pixels(texels * size_t(channels));
     if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, pixels.data()))
-      throw Error(path + ": cannot read texture (" + in->geterror() + ")");
+      throw Error("texture '" + path + "': cannot decode it (" + in->geterror() + ")");
     t.format = TextureData::kSrgb8;
     t.words.resize(texels);
     for (size_t p = 0; p < texels; ++p)
@@ -166,7 +165,7 @@ TextureData loadTexture(const std::string& path) {
   }
   std::vector<float> pixels(texels * size_t(channels));
   if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data()))
-    throw Error(path + ": cannot read texture (" + in->geterror() + ")");
+    throw Error("texture '" + path + "': cannot decode it (" + in->geterror() + ")");
   // 16-bit images hold sRGB-encoded colour too; float images are linear already.
   const bool srgb = spec.format.basetype == OIIO::TypeDesc::UINT16;
   t.words.resize(4 * texels);

@@ -2,12 +2,11 @@
 #include "scene/camera.h"
 
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "base/error.h"
+#include "base/input_file.h"
 #include "base/vec.h"
 
 namespace fh {
@@ -33,12 +32,8 @@ std::array<float, 3> readVec3(const nlohmann::json& j, const char* key, const st
 
 }  // namespace
 
-Camera loadCameraJson(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path + ": cannot open camera file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parseCameraJson(text.str(), path);
+Camera loadCameraJson(const std::string& path, const std::string& what) {
+  return parseCameraJson(readInputFile(path, what, kMaxCameraBytes), path);
 }
 
 Camera parseCameraJson(const std::string& text, const std::string& path) {

@@ -3,6 +3,7 @@
 // Pixel (0,0) is the top-left of the image; the right vector is forward x up.
 #pragma once
 #include <array>
+#include <cstdint>
 #include <string>
 
 #include "kernels/types.h"
@@ -22,8 +23,13 @@ struct CameraFrame {
   float tanHalfFovY = 0.f, aspect = 1.f;
 };
 
-// Reads {"eye","target","up","fov_y_deg"}; errors name the file and the bad key.
-Camera loadCameraJson(const std::string& path);
+// The most a camera file may hold: a few numbers, with room for whitespace and comments.
+constexpr uint64_t kMaxCameraBytes = uint64_t(1) << 20;
+
+// Reads {"eye","target","up","fov_y_deg"} through the input gate (base/input_file.h: a
+// regular file of at most kMaxCameraBytes); errors name the file (as `what`, its role:
+// "--camera", or "camera" for a scene's .camera.json) and the bad key.
+Camera loadCameraJson(const std::string& path, const std::string& what = "--camera");
 Camera parseCameraJson(const std::string& text, const std::string& name);
 
 // Parses "x,y,z" given to `flag`; errors name the flag.

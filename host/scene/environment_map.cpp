@@ -96,12 +96,7 @@ EnvironmentMap loadEnvironmentMap(const std::string& path, float rotateDeg, floa
   const std::string ext = extensionOf(path);
   if (ext != ".exr" && ext != ".hdr")
     throw Error("--env-map '" + path + "': an environment map must be an .exr or .hdr latitude-longitude image");
-  Image image;
-  try {
-    image = readImage(path);
-  } catch (const Error& e) {
-    throw Error("--env-map: " + std::string(e.what()));
-  }
+  const Image image = readImage(path, "--env-map");
   return makeEnvironmentMap(path, image.width, image.height, image.rgb, rotateDeg, scale);
 }
 

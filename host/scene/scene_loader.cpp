@@ -269,7 +269,7 @@ Scene loadScene(const std::string& objPath) {
   const fs::path sidecar = fs::path(path).replace_extension(".camera.json");
   std::error_code ec;
   if (fs::exists(sidecar, ec)) {
-    scene.camera = loadCameraJson(sidecar.string());
+    scene.camera = loadCameraJson(sidecar.string(), "camera");
     scene.hasCamera = true;
   }
   return scene;
