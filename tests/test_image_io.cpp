@@ -1,13 +1,14 @@
 // Image output: formats by extension, round trips, metadata, and the checks made before
 // rendering (unknown extension, unwritable path, no overwrite without --force). Input: every
 // file fredholm reads goes through one gate (devices, FIFOs and headers that lie are refused
-// in one line naming the file and its role).
+// in one line naming the file and its role), and compare refuses images that are not finite.
 #include <gtest/gtest.h>
 
 #include <OpenImageIO/imageio.h>
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -219,6 +220,34 @@ TEST(InputGateCli, ATextureWhoseHeaderLiesIsAWarningNamingItsClaim) {
                      "compare");
 }
 
+// compare on an image with a NaN or infinite pixel names the file and the first such pixel
+// (it printed null metrics and exit 0).
+TEST(CompareCli, ANonFiniteImageIsRefusedNamingItsFirstBadPixel) {
+  const std::string dir = test::tempDir("gate");
+  Image good = gradient(4, 3), nan = good, inf = good;
+  nan.rgb[3 * (1 * 4 + 2) + 1] = NAN;       // (2, 1), green
+  nan.rgb[3 * (2 * 4 + 3)] = INFINITY;      // (3, 2): later
+  inf.rgb[3 * (0 * 4 + 3) + 2] = -INFINITY;  // (3, 0), blue
+  writeImage(dir + "/good.exr", good, {});
+  writeImage(dir + "/nan.exr", nan, {});
+  writeImage(dir + "/inf.exr", inf, {});
+  const auto a = test::runFredholm("compare " + dir + "/nan.exr " + dir + "/good.exr");
+  EXPECT_EQ(a.exitCode, 1) << a.output;
+  EXPECT_NE(a.output.find("fredholm: error: compare '" + dir + "/nan.exr': pixel (2, 1) is not finite ("),
+            std::string::npos)
+      << a.output;
+  const auto b = test::runFredholm("compare " + dir + "/good.exr " + dir + "/inf.exr");
+  EXPECT_EQ(b.exitCode, 1) << b.output;
+  EXPECT_NE(b.output.find("fredholm: error: compare '" + dir + "/inf.exr': pixel (3, 0) is not finite ("),
+            std::string::npos)
+      << b.output;
+  for (const auto* r : {&a, &b}) {
+    EXPECT_EQ(r->output.find("null"), std::string::npos) << r->output;
+    EXPECT_EQ(std::count(r->output.begin(), r->output.end(), '\n'), 1) << r->output;
+  }
+  EXPECT_EQ(test::runFredholm("compare " + dir + "/good.exr " + dir + "/good.exr").exitCode, 0);
+}
+
 }  // namespace
 }  // namespace fh
 
@@ -242,6 +271,23 @@ TEST(ErrorMetrics, KnownValues) {
   EXPECT_THROW(imageError(small, ref), Error);
   EXPECT_NEAR(e.meanImage[0], 0.8, 1e-6);
   EXPECT_NEAR(e.meanReference[0], 0.5, 1e-6);
+}
+
+TEST(ErrorMetrics, RequireFiniteNamesTheFirstBadPixel) {
+  Image img;
+  img.width = 3;
+  img.height = 2;
+  img.rgb.assign(18, 0.5f);
+  EXPECT_NO_THROW(requireFinite(img, "x"));
+  img.rgb[3 * 5 + 2] = INFINITY;
+  img.rgb[3 * 4] = NAN;
+  try {
+    requireFinite(img, "compare 'a.exr'");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("compare 'a.exr': pixel (1, 1) is not finite (nan 0.5 0.5)", 0), 0u)
+        << e.what();
+  }
 }
 
 TEST(ErrorMetrics, BlockAverage) {

@@ -40,6 +40,8 @@ int runDevices(const std::string& spec) {
 int runCompare(const CompareOptions& o) {
   if (o.block < 1) throw Error("--block must be at least 1");
   Image image = readImage(o.image, "compare"), reference = readImage(o.reference, "compare");
+  requireFinite(image, "compare '" + o.image + "'");
+  requireFinite(reference, "compare '" + o.reference + "'");
   if (o.block > 1) {
     try {
       image = blockAverage(image, o.block);

@@ -2,6 +2,7 @@
 #include "image/error_metrics.h"
 
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,23 @@ ImageError imageError(const Image& image, const Image& reference) {
   e.rmse = std::sqrt(e.rmse / double(n));
   e.mae /= double(n);
   return e;
+}
+
+void requireFinite(const Image& image, const std::string& source) {
+  const size_t pixels = size_t(image.width) * size_t(image.height);
+  for (size_t p = 0; p < pixels && 3 * p + 2 < image.rgb.size(); ++p) {
+    const float* rgb = &image.rgb[3 * p];
+    if (std::isfinite(rgb[0]) && std::isfinite(rgb[1]) && std::isfinite(rgb[2])) continue;
+    std::string values;
+    for (int c = 0; c < 3; ++c) {
+      std::ostringstream v;
+      v << rgb[c];
+      values += (c ? " " : "") + v.str();
+    }
+    throw Error(source + ": pixel (" + std::to_string(p % size_t(image.width)) + ", " +
+                std::to_string(p / size_t(image.width)) + ") is not finite (" + values +
+                "); metrics need finite radiance everywhere");
+  }
 }
 
 Image blockAverage(const Image& image, int k) {

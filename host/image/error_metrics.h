@@ -3,6 +3,7 @@
 // mean absolute error, over linear radiance.
 #pragma once
 #include <array>
+#include <string>
 
 #include "image/image_io.h"
 
@@ -20,6 +21,10 @@ struct ImageError {
 
 // Throws fh::Error if the sizes differ.
 ImageError imageError(const Image& image, const Image& reference);
+
+// Throws fh::Error, "SOURCE: pixel (x, y) ...", naming the first pixel (in rows from the top)
+// with a channel that is not finite: metrics over it would be NaN or infinite.
+void requireFinite(const Image& image, const std::string& source);
 
 // The image averaged over k x k pixel blocks: comparing block averages separates a bias
 // that covers a region from per-pixel noise (k^2 times less of it). Throws fh::Error
