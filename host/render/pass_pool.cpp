@@ -97,7 +97,7 @@ bool PassPool::take(int worker, Pass& pass) {
       break;
     }
     if (noiseReached_) return false;
-    const NewPass next = nextNewPass(pass.index);
+    const NewPass next = mergerBehind() ? NewPass::Later : nextNewPass(pass.index);
     if (next == NewPass::Given) break;
     const bool mine = !outstanding_[size_t(worker)].empty();
     if (mine || (next == NewPass::None && !anyOutstanding())) return false;
@@ -106,6 +106,16 @@ bool PassPool::take(int worker, Pass& pass) {
   pass.pixels = roundOf(pass.index)->pixels;
   outstanding_[size_t(worker)].insert(pass.index);
   return true;
+}
+
+// Finished passes wait in memory for the merger, which adds them one at a time: a fast GPU
+// outruns it on large images, and the waiting passes grew by gigabytes. Past a budget, no
+// new pass starts until the merger catches up (workers finish the passes they hold).
+bool PassPool::mergerBehind() const {
+  constexpr size_t kPendingBudgetBytes = size_t(512) << 20;
+  size_t bytes = 0;
+  for (const auto& entry : pending_) bytes += entry.second.size() * sizeof(float);
+  return pending_.size() >= 2 && bytes >= kPendingBudgetBytes;
 }
 
 // A pass no one has rendered yet: from the ledger where processes share the render, else
@@ -292,6 +302,7 @@ void PassPool::mergeInOrder() {
       recordRounds();
       changed_.notify_all();  // workers may wait for the round
     }
+    changed_.notify_all();  // workers may wait for the merger to catch up
     checkpoint(false);
     if (check) noiseEstimate_ = estimate;
     showProgress();

@@ -54,6 +54,7 @@ class PassPool : public PassSource {
   bool anyOutstanding() const;
   enum class NewPass { Given, Later, None };  // Later: once the merger chooses the next round
   NewPass nextNewPass(uint32_t& pass);
+  bool mergerBehind() const;  // under the lock
   // Runs of passes over the same pixels: every pass of a render but an adaptive one's in one.
   struct Round {
     uint32_t begin = 0, end = 0;
