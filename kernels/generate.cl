@@ -10,7 +10,7 @@
 // `slot`. Its passes are granted by the host, which may hand different passes to different
 // devices: from a shape's first sample on, every shape.pixels samples are one local pass,
 // whose global pass and first entry in the pass buffers are in pass_table at its pass slot,
-// and sample i of a pass renders the shape's i-th listed pixel into the entry i after its
+// and sample i of a pass renders the shape's i-th pixel (types.h) into the entry i after its
 // pass's (pass_entry, with the slot), around the ring of `entries`. Samples before
 // newer.first_sample are of the older shape; local numbers wrap, so samples are compared by
 // their distance from the older shape's first (the host starts a new shape before one
@@ -28,9 +28,16 @@ FH_INLINE void start_sample(RenderParams params, PassShape older, PassShape newe
   const luint local_pass = select((luint)(older.first_pass), (luint)(newer.first_pass), is_newer) + in_shape / pixels;
   const luint pass_slot = local_pass % FH_MAX_PASS_SLOTS;
   const luint index = in_shape % pixels;
-  const luint listed = select((luint)(older.list), (luint)(newer.list), is_newer) + index;
-  const luint pixel = gather_uint(pixel_list, listed);
-  const luint point = gather_uint(pass_table, 2u * pass_slot) + gather_uint(pixel_list, listed + 2u * params.pixel_count);
+  // A shape of every pixel lists none (FH_EVERY_PIXEL): its i-th pixel is pixel i, at offset 0.
+  const luint list = select((luint)(older.list), (luint)(newer.list), is_newer);
+  const lmask listed = list != FH_EVERY_PIXEL;
+  luint pixel = index, offset = (luint)(0);
+  if (lanes_any(listed)) {
+    pixel = select(index, gather_uint(pixel_list, select((luint)(0), list + index, listed)), listed);
+    offset = select(offset, gather_uint(pixel_list, select((luint)(0), list + index + 2u * params.pixel_count, listed)),
+                    listed);
+  }
+  const luint point = gather_uint(pass_table, 2u * pass_slot) + offset;
   const luint entry = (gather_uint(pass_table, 2u * pass_slot + 1u) + index) % entries;
   const PixelSampler sampler = pixel_sampler_at(params.seed, point, pixel, params.replicates);
   const lvec2 u = sample_2d(&sampler, (luint)(FH_DIM_PIXEL));

@@ -114,9 +114,11 @@ typedef struct {
 #define FH_TEXELS_SRGB8 1u
 
 // The shape of a run of passes: each covers `pixels` pixels, those listed from `list` on in
-// the pixel list (every pixel, or an adaptive round's, render/adaptive.h); its first pass is
-// local pass `first_pass` and starts at local sample `first_sample` (local sample numbers
-// are 32 bits and wrap: host/render/wavefront.h).
+// the pixel list (an adaptive round's, render/adaptive.h), or with list FH_EVERY_PIXEL every
+// pixel in order at sequence offset 0, read from no list; its first pass is local pass
+// `first_pass` and starts at local sample `first_sample` (local sample numbers are 32 bits
+// and wrap: host/render/wavefront.h).
+#define FH_EVERY_PIXEL 0xFFFFFFFFu
 typedef struct {
   uint pixels;
   uint first_sample;

@@ -112,7 +112,8 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
       strategy_(strategyFor(dc.info, s.strategy)),
       scene_(dc, scene, bvh, featuresFor(scene, s), s.envMap.get()),
       pixels_(unsigned(s.width) * unsigned(s.height)),
-      surfaceAovs_(s.surfaceAovs) {
+      surfaceAovs_(s.surfaceAovs),
+      listsPixels_(s.adaptive) {
   // No more paths than the passes in flight can ever hold.
   const size_t most = roundUp(size_t(kMostFullPasses) * pixels_, kLocalSize);
   wavefront_ = std::min(s.wavefront ? s.wavefront : defaultWavefront(dc.info, pixels_), most);
@@ -133,12 +134,7 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
   // time the newer one outgrows its span (no wait for a new shape of the same pixels).
   shapeSpan_ = 4 * uint64_t(passEntries_);
   passes_.assign(FH_MAX_PASS_SLOTS, {});
-  everyPixel_ = everyPixel(pixels_);
-  noOffsets_.assign(pixels_, 0u);
-  lists_ = {everyPixel_, {}};
-  offsets_ = {noOffsets_, {}};
-  // Every pixel, listed in the first half.
-  shapes_[0] = shapes_[1] = {pixels_, uint32_t(kFirstLocalSample), 0, 0};
+  shapes_[0] = shapes_[1] = {pixels_, uint32_t(kFirstLocalSample), 0, FH_EVERY_PIXEL};
   std::copy(shapes_.begin(), shapes_.end(), counters_.shapes);
   counters_.next_sample = counters_.sample_limit = uint32_t(kFirstLocalSample);
   counters_.pass_entries = uint32_t(passEntries_);
@@ -182,10 +178,8 @@ void WavefrontPipeline::allocateBuffers(const std::vector<float>& filterTable) {
   filterTable_ = allocateBuffer(dc_.context, dc_.info.device, CL_MEM_READ_ONLY, filterTable.size() * 4,
                                 "filter table", filterTable.data());
   passTableBuffer_ = buffer(FH_MAX_PASS_SLOTS * sizeof(PassInFlight::table), "pass table");
-  // Each shape's list in a half of its own, then each one's sequence offsets (zero here).
-  std::vector<uint32_t> lists(4 * size_t(pixels_), 0u);
-  std::copy(everyPixel_.begin(), everyPixel_.end(), lists.begin());
-  pixelListBuffer_ = buffer(lists.size() * 4, "pixel lists", lists.data());
+  // Two shapes' lists in a half each, then their sequence offsets (written by newShape).
+  pixelListBuffer_ = buffer(listsPixels_ ? 4 * size_t(pixels_) * 4 : 16, "pixel lists");
 }
 
 // Every argument of every stage, for one parity. The argument lists follow the kernels'
@@ -278,25 +272,30 @@ void WavefrontPipeline::grantPass(uint64_t local, uint32_t global, std::shared_p
 }
 
 // The newer shape becomes the older, and local pass `local` on is of the new one, whose
-// pixel list takes the half of the pixel-list buffer the older's older had; or, for a new
-// shape of the newer's own pixels (it outgrew its span), the half the newer has.
+// pixel list (if it lists pixels) takes the half of the pixel-list buffer the newer does not
+// have (the older's, whose samples have all started); or, for a new shape of the newer's own
+// pixels (it outgrew its span), the newer's.
 void WavefrontPipeline::newShape(std::shared_ptr<const RoundPixels> pixels, uint64_t local) {
-  const bool samePixels = pixels == shapePixels_[1];
-  const std::vector<uint32_t>& list = pixels ? pixels->pixels : everyPixel_;
-  const std::vector<uint32_t>& offsets = pixels ? pixels->offsets : noOffsets_;
-  if (list.empty() || list.size() > pixels_ || offsets.size() != list.size())
-    throw Error("internal: a pass of no pixels, of too many, or without an offset for each");
-  const size_t newerHalf = shapes_[1].list == 0 ? 0 : 1, half = samePixels ? newerHalf : 1 - newerHalf;
-  if (!samePixels) {
-    lists_[half] = list;  // stable storage for the writes
-    offsets_[half] = offsets;
-    FH_CL(dc_.queue.enqueueWriteBuffer(pixelListBuffer_, CL_FALSE, half * pixels_ * 4, list.size() * 4,
-                                       lists_[half].data()));
-    FH_CL(dc_.queue.enqueueWriteBuffer(pixelListBuffer_, CL_FALSE, (2 + half) * pixels_ * 4, list.size() * 4,
-                                       offsets_[half].data()));
+  uint32_t size = pixels_, list = FH_EVERY_PIXEL;
+  if (pixels) {
+    size = uint32_t(pixels->pixels.size());
+    if (!listsPixels_ || size == 0 || size > pixels_ || pixels->offsets.size() != size)
+      throw Error("internal: a pass of no pixels, of too many, without an offset for each, or not adaptive");
+    if (pixels == shapePixels_[1]) {
+      list = shapes_[1].list;
+    } else {
+      const size_t half = shapes_[1].list == pixels_ ? 0 : 1;
+      lists_[half] = pixels->pixels;  // stable storage for the writes
+      offsets_[half] = pixels->offsets;
+      FH_CL(dc_.queue.enqueueWriteBuffer(pixelListBuffer_, CL_FALSE, half * pixels_ * 4, size_t(size) * 4,
+                                         lists_[half].data()));
+      FH_CL(dc_.queue.enqueueWriteBuffer(pixelListBuffer_, CL_FALSE, (2 + half) * pixels_ * 4, size_t(size) * 4,
+                                         offsets_[half].data()));
+      list = uint32_t(half * pixels_);
+    }
   }
   shapes_[0] = shapes_[1];
-  shapes_[1] = {uint32_t(list.size()), uint32_t(grantedSamples_), uint32_t(local), uint32_t(half * pixels_)};
+  shapes_[1] = {size, uint32_t(grantedSamples_), uint32_t(local), list};
   shapeStart_ = grantedSamples_;
   shapePixels_[0] = std::move(shapePixels_[1]);
   shapePixels_[1] = std::move(pixels);

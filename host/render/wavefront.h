@@ -160,13 +160,15 @@ class WavefrontPipeline {
   // longer run of passes over the same pixels is a new shape of them (the sample's place in
   // its shape, kernels/generate.cl, stays far below 2^32).
   uint64_t shapeStart_ = kFirstLocalSample, shapeSpan_ = 0;
-  // The two shapes of WavefrontCounters (stable storage for writes) and the pixel lists
-  // they cover (null: every pixel, listed in everyPixel_, offsets 0); a shape's list is in
-  // the half of the pixel-list buffer at its `list`, its sequence offsets two halves on.
+  // The two shapes of WavefrontCounters (stable storage for writes) and the pixels they
+  // cover (null: every pixel, offsets 0, listed nowhere: FH_EVERY_PIXEL); a listed shape's
+  // list is in the half of the pixel-list buffer at its `list`, its sequence offsets two
+  // halves on. Only an adaptive render lists pixels (listsPixels_): the buffer is a
+  // placeholder in the others (16 bytes a pixel saved).
   std::array<gpu::PassShape, 2> shapes_{};
   std::array<std::shared_ptr<const RoundPixels>, 2> shapePixels_;
   std::array<std::vector<uint32_t>, 2> lists_, offsets_;  // each half's (stable storage for writes)
-  std::vector<uint32_t> everyPixel_, noOffsets_;
+  bool listsPixels_;
   gpu::WavefrontCounters counters_{};
   // Every stage's kernel twice, bound once for each parity: an iteration sets nothing.
   std::array<std::array<cl::Kernel, kStages.size()>, 2> kernels_;
