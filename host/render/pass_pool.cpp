@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <csignal>
 #include <cstdlib>
+#include <utility>
 
 #include "base/error.h"
 #include "render/adaptive.h"
@@ -184,9 +185,10 @@ Film PassPool::finish(bool& complete) {
     mergedSamples_ += double(round.size);
   }
   pending_.clear();
+  spare_.clear();  // a frame of samples each
   if (settings_.ledger) progress_.end();  // other processes may still be rendering
   else progress_.finish(uint64_t(mergedSamples_ - resumedSamples_), secondsSince(start_));
-  return film_;
+  return std::move(film_);  // not a copy of its sums (64 bytes a pixel): the pool is done with it
 }
 
 // The round from pass `begin` on covers `pixels` (null, or every pixel listed: every pixel).

@@ -44,7 +44,7 @@ class PassPool : public PassSource {
   uint64_t samplesDone(int worker) const;
   // Ends the render: saves the checkpoint (the passes merged in order), merges whatever
   // finished out of order (passes lost with every device leave gaps: the film records which
-  // passes it holds), closes the progress display, and returns the film. `complete` is
+  // passes it holds), closes the progress display, and hands the film over (once). `complete` is
   // false when some pass was never rendered.
   Film finish(bool& complete);
   // Checkpoints that could not be written (the render goes on without them).
