@@ -42,6 +42,7 @@ void DeviceWorker::takePasses() {
 void DeviceWorker::returnCompletePasses() {
   while (returned_ < granted_ && pipeline_.passComplete(returned_)) {
     const uint32_t pass = pipeline_.globalPass(returned_);
+    source_.reuse(samples_);
     pipeline_.takePass(returned_, samples_);
     if (failAfter_ >= 0 && long(returned_) >= failAfter_)
       throw Error("simulated failure (FREDHOLM_FAIL_DEVICE) on finishing pass " + std::to_string(pass));

@@ -142,18 +142,21 @@ PassPool::NewPass PassPool::nextNewPass(uint32_t& pass) {
   return NewPass::Given;
 }
 
-// Hands the samples over (the worker gets a spare buffer back) and returns at once.
+// Takes the samples over (the worker's vector is left empty) and returns at once.
 void PassPool::done(int worker, uint32_t pass, std::vector<float>& samples) {
   std::lock_guard<std::mutex> lock(mutex_);
   outstanding_[size_t(worker)].erase(pass);
   ++done_[size_t(worker)];
   samplesDone_[size_t(worker)] += roundOf(pass)->size;
   pending_[pass].swap(samples);
-  if (!spare_.empty()) {
-    samples.swap(spare_.back());
-    spare_.pop_back();
-  }
   changed_.notify_all();
+}
+
+void PassPool::reuse(std::vector<float>& samples) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!samples.empty() || spare_.empty()) return;
+  samples.swap(spare_.back());
+  spare_.pop_back();
 }
 
 void PassPool::fail(int worker) {

@@ -38,6 +38,7 @@ class PassPool : public PassSource {
 
   bool take(int worker, Pass& pass) override;
   void done(int worker, uint32_t pass, std::vector<float>& samples) override;
+  void reuse(std::vector<float>& samples) override;
   void fail(int worker) override;
 
   uint64_t passesDone(int worker) const;

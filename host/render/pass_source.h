@@ -44,8 +44,12 @@ class PassSource {
   // is back, so a device never has passes of two shapes in flight.
   virtual bool take(int worker, Pass& pass) = 0;
   // A finished pass's samples: rgb and 1 for each pixel it covers, in order (may be
-  // swapped out).
+  // swapped out: `samples` is then left empty).
   virtual void done(int worker, uint32_t pass, std::vector<float>& samples) = 0;
+  // Swaps the buffer of a pass merged already into an empty `samples`, to take the next pass
+  // (asked for then, not when a pass is done: a buffer is a frame of samples, and the
+  // one merged meanwhile serves); may leave it empty.
+  virtual void reuse(std::vector<float>& samples) { (void)samples; }
   // The worker stopped: the passes it had taken must be rendered by others.
   virtual void fail(int worker) = 0;
 };
