@@ -6,7 +6,8 @@
 #   bench/gpu/run_scale.sh [--small] FREDHOLM OUTDIR
 #
 # FREDHOLM is a bundle from bench/gpu/make_bundle.sh or a fredholm binary. --small renders
-# 64x36 at 4 spp instead (a check of the script on any machine). OUTDIR/scale.txt has the
+# 64x36 at 4 spp instead (a check of the script on any machine); SCALE_SIZES="W H SPP;..."
+# picks other sizes. OUTDIR/scale.txt has the
 # figures; OUTDIR/log.txt every command and its output.
 set -uo pipefail
 
@@ -31,6 +32,7 @@ if [ $small -eq 1 ]; then
 else
   sizes=("3840 2160 1024" "1920 1080 4096" "7680 4320 256")
 fi
+if [ -n "${SCALE_SIZES:-}" ]; then IFS=';' read -r -a sizes <<<"$SCALE_SIZES"; fi
 timer=()
 [ -x /usr/bin/time ] && timer=(/usr/bin/time -v)
 
