@@ -150,6 +150,8 @@ TEST(Budgets, EveryBudgetRendersAtLeastOnePass) {
   ASSERT_EQ(r.exitCode, 0) << r.output;
   EXPECT_NE(metadataOf(dir + "/t.exr", "spp"), "0.00") << r.output;
   EXPECT_EQ(r.output.find(" on  in "), std::string::npos) << "a device named in the summary: " << r.output;
+  EXPECT_NE(r.output.find("--time 1e-09 without --spp: as many samples per pixel as the time allows"),
+            std::string::npos) << r.output;
   // One sample per pixel holds no estimate of its own error: none is written.
   r = test::runFredholm("render --width 8 --height 8 --spp 1 -o " + dir + "/one.exr");
   ASSERT_EQ(r.exitCode, 0) << r.output;

@@ -328,6 +328,10 @@ void printSummary(const RenderOptions& o, const RenderSettings& settings, const 
 
 int runRender(RenderOptions o) {
   RenderSettings settings = settingsFrom(o);
+  // Without --spp a time budget is the only bound: the 64-spp default does not apply.
+  if (o.seconds > 0 && !o.spp && o.noise == 0 && o.passes.empty())
+    std::cerr << "fredholm: --time " << o.seconds << " without --spp: as many samples per pixel as the time allows "
+                 "(--spp caps them)\n";
   settings.stop = &installInterruptHandlers();
   const bool debugView = !o.aov.empty();
   const Aov aov = debugView ? parseAov(o.aov) : Aov::Albedo;
