@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cctype>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -244,6 +245,76 @@ void checkPngChunks(const std::string& path, const std::string& what) {
     in.seekg(at);
   }
 }
+
+uint32_t littleEndian32(const unsigned char* b) {
+  return uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
+}
+
+// An OpenEXR file's headers must fit in it too: OpenEXR allocates what an attribute's size
+// claims before reading it (a string attribute claiming 1.6 GB in a 900-byte file, found by
+// fuzzing), and an offset table as long as a part's data window is tall, all while opening
+// the file, before its spec can be checked. So each attribute must fit in the file, and each
+// part's data window and channels are a claim like any header's (checkImageClaim). A header
+// cut short is left to OpenEXR to report.
+void checkExrHeaders(const std::string& path, const std::string& what, uint64_t fileBytes) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char head[8];
+  if (!in.read(reinterpret_cast<char*>(head), 8) || littleEndian32(head) != 20000630u) return;
+  const bool multiPart = (littleEndian32(head + 4) & 0x1000u) != 0;
+  uint64_t at = 8;
+  // A name or type: NUL-terminated, at most 255 bytes.
+  const auto readName = [&](std::string& text) {
+    text.clear();
+    for (char c; in.get(c);) {
+      ++at;
+      if (c == '\0') return true;
+      if (text.size() == 255) return false;
+      text += c;
+    }
+    return false;
+  };
+  for (;;) {
+    long long width = 0, height = 0, channels = 0;
+    bool window = false, any = false;
+    for (std::string name, type;;) {
+      if (!readName(name)) return;
+      if (name.empty()) break;
+      any = true;
+      unsigned char size[4];
+      if (!readName(type) || !in.read(reinterpret_cast<char*>(size), 4)) return;
+      at += 4;
+      const uint32_t bytes = littleEndian32(size);
+      if (bytes > fileBytes - std::min(at, fileBytes))
+        throw Error(what + " '" + path + "': its EXR attribute '" + name + "' claims " + std::to_string(bytes) +
+                    " bytes, more than the file holds");
+      at += bytes;
+      const bool isWindow = name == "dataWindow" && type == "box2i" && bytes == 16;
+      const bool isChannels = name == "channels" && type == "chlist";
+      if (!isWindow && !isChannels) {
+        in.seekg(std::streamoff(bytes), std::ios::cur);
+        continue;
+      }
+      std::string value(bytes, '\0');
+      if (!in.read(&value[0], std::streamsize(bytes))) return;
+      const auto* v = reinterpret_cast<const unsigned char*>(value.data());
+      if (isWindow) {
+        window = true;
+        width = (long long)int32_t(littleEndian32(v + 8)) - (long long)int32_t(littleEndian32(v)) + 1;
+        height = (long long)int32_t(littleEndian32(v + 12)) - (long long)int32_t(littleEndian32(v + 4)) + 1;
+      } else {
+        // Each channel: its name, NUL, then 16 bytes; an empty name ends the list.
+        for (size_t i = 0; i < value.size() && value[i] != '\0'; ++channels) {
+          const size_t end = value.find('\0', i);
+          if (end == std::string::npos) break;
+          i = end + 17;
+        }
+      }
+    }
+    if (!any) return;  // the empty header that ends a multi-part file's list
+    if (window) checkImageClaim(path, what, width, height, std::max(channels, 1LL), fileBytes, kMaxImagePixels);
+    if (!multiPart) return;
+  }
+}
 #endif
 
 }  // namespace
@@ -251,7 +322,12 @@ void checkPngChunks(const std::string& path, const std::string& what) {
 #ifdef FREDHOLM_HAVE_OIIO
 std::unique_ptr<OIIO::ImageInput> openImageInput(const std::string& path, const std::string& what) {
   const uint64_t fileBytes = checkInputFile(path, what);
-  if (extensionOf(path) == ".png") checkPngChunks(path, what);
+  // By content, not extension: OpenImageIO tries every format on a file its extension's
+  // reader refuses.
+  unsigned char magic[8] = {};
+  std::ifstream(path, std::ios::binary).read(reinterpret_cast<char*>(magic), 8);
+  if (std::memcmp(magic, "\x89PNG\r\n\x1a\n", 8) == 0) checkPngChunks(path, what);
+  checkExrHeaders(path, what, fileBytes);
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw Error(what + " '" + path + "': cannot read it as an image (" + oneLine(OIIO::geterror()) + ")");
   const OIIO::ImageSpec& spec = in->spec();
@@ -273,14 +349,16 @@ Image readImage(const std::string& path, const std::string& what) {
   Image image;
   image.width = spec.width;
   image.height = spec.height;
-  std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data()))
+  // The first three channels only: what the image holds beyond R, G, B is never allocated.
+  const int used = std::min(spec.nchannels, 3);
+  std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(used));
+  if (!in->read_image(0, 0, 0, used, OIIO::TypeDesc::FLOAT, pixels.data()))
     throw Error(what + " '" + path + "': cannot decode it (" + oneLine(in->geterror()) + ")");
   const bool srgb = spec.format == OIIO::TypeDesc::UINT8;
   image.rgb.resize(size_t(spec.width) * size_t(spec.height) * 3);
   for (size_t p = 0; p < size_t(spec.width) * size_t(spec.height); ++p)
     for (int c = 0; c < 3; ++c) {
-      const float v = pixels[p * size_t(spec.nchannels) + size_t(std::min(c, spec.nchannels - 1))];
+      const float v = pixels[p * size_t(used) + size_t(std::min(c, used - 1))];
       image.rgb[3 * p + size_t(c)] = srgb ? srgbToLinear(v) : v;
     }
   return image;

@@ -146,9 +146,10 @@ TextureData loadTexture(const std::string& path) {
 #else
   const auto in = openImageInput(path, "texture");
   const OIIO::ImageSpec& spec = in->spec();
-  const int channels = spec.nchannels;
+  // R, G, B, or one grey channel: only those are read (channels past them are never allocated).
+  const int channels = spec.nchannels >= 3 ? 3 : 1;
   const size_t texels = size_t(spec.width) * size_t(spec.height);
-  auto channel = [&](size_t p, int c) { return p * size_t(channels) + size_t(channels >= 3 ? c : 0); };
+  auto channel = [&](size_t p, int c) { return p * size_t(channels) + size_t(channels == 3 ? c : 0); };
   TextureData t;
   t.width = spec.width;
   t.height = spec.height;
