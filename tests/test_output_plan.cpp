@@ -116,7 +116,9 @@ TEST(OutputPlan, AFileThatAppearsDuringTheRenderIsKept) {
 // Two renders with the default name in one directory take two names.
 TEST(OutputPlan, ConcurrentRendersNeverReplaceEachOther) {
   const std::string dir = test::tempDir("plan");
-  const std::string render = std::string(FREDHOLM_BINARY) + " render --width 16 --height 16 --spp 64";
+  // Each renders for 3 s after its outputs are planned, so the four overlap however their
+  // start-ups differ: every plan is made before any render commits.
+  const std::string render = std::string(FREDHOLM_BINARY) + " render --width 16 --height 16 --spp 1000000 --time 3";
   const auto r = test::runCommand("cd " + dir + " && { (" + render + " -o same.png > a.log 2>&1; echo $? > a.rc) & (" +
                                   render + " -o same.png > b.log 2>&1; echo $? > b.rc) & (" + render +
                                   " > c.log 2>&1) & (" + render + " > d.log 2>&1) & wait; }");
@@ -136,10 +138,16 @@ TEST(OutputPlan, ConcurrentRendersNeverReplaceEachOther) {
 TEST(OutputPlan, SignalsKeepTheRenderOrLeaveNothing) {
   const std::string dir = test::tempDir("plan");
   const std::string render = std::string(FREDHOLM_BINARY) + " render --width 16 --height 16 --spp 1000000 ";
-  auto r = test::runCommand("cd " + dir + " && " + render + "-o hup.exr & p=$!; sleep 4; kill -HUP $p; wait $p");
+  // The signal goes once a pass is finished: the progress display has counted its samples.
+  const auto afterFirstPass = [&](const std::string& name, const std::string& signals) {
+    return test::runCommand("cd " + dir + " && { " + render + "-o " + name + ".exr 2> " + name +
+                            ".log & p=$!; for i in $(seq 1200); do grep -q samples " + name +
+                            ".log && break; sleep 0.1; done; " + signals + " wait $p; }");
+  };
+  auto r = afterFirstPass("hup", "kill -HUP $p;");
   EXPECT_EQ(r.exitCode, 128 + 1) << r.output;
   EXPECT_NE(metadataOf(dir + "/hup.exr", "incomplete").find("signal 1"), std::string::npos) << r.output;
-  r = test::runCommand("cd " + dir + " && " + render + "-o int.exr & p=$!; sleep 4; kill -INT $p; kill -INT $p; wait $p");
+  r = afterFirstPass("int", "kill -INT $p; kill -INT $p;");
   EXPECT_EQ(r.exitCode, 128 + 2) << r.output;
   EXPECT_EQ(temporaryFiles(dir), 0);
 }
