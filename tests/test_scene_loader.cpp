@@ -451,7 +451,8 @@ TEST_F(Mtl, ImpossibleIndexOfRefractionAndExponentRefused) {
   EXPECT_NE(mtlError("newmtl a\nillum 2.5\n").find("scene.mtl:2: 'illum 2.5' is not a whole number"),
             std::string::npos);
   // What is valid loads as before.
-  const Material& m = used(load("newmtl a\nillum 7\nNi 1.33\nNs 0\n"));
+  const Scene scene = load("newmtl a\nillum 7\nNi 1.33\nNs 0\n");
+  const Material& m = used(scene);  // the scene outlives the reference
   EXPECT_FLOAT_EQ(m.ni, 1.33f);
   EXPECT_EQ(m.ns, 0.f);
   EXPECT_EQ(m.illum, 7);
