@@ -5,11 +5,6 @@
 // reads one and fills the other.
 #include "types.h"
 
-// A megakernel launch starts up to this many samples per path slot: each slot takes its
-// next sample where its path ends. More per launch means fewer launches, fewer means
-// passes come back and a stop is seen sooner.
-#define FH_MEGAKERNEL_SAMPLES_PER_SLOT 4
-
 __kernel void plan_iteration(volatile __global WavefrontCounters* counters, uint parity) {
   if (get_global_id(0) != 0) return;
   // Local sample numbers wrap (mod 2^32): the samples granted and not yet started are

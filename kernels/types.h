@@ -103,6 +103,10 @@ typedef struct {
 // waiting for any: it reads this back only now and then. 64-bit totals are (low, high)
 // pairs, as OpenCL 1.2 has no 64-bit atomics to rely on.
 #define FH_MAX_PASS_SLOTS 64  // passes in flight at most: local pass p is in pass slot p % this
+// A megakernel launch starts up to this many samples per path slot: each slot takes its
+// next sample where its path ends. More per launch means fewer launches, fewer means
+// passes come back and a stop is seen sooner.
+#define FH_MEGAKERNEL_SAMPLES_PER_SLOT 4
 // A path's pass_entry: its sample's entry in the pass buffers and its pass's slot, in one uint.
 #define FH_PASS_ENTRY(entry, slot) ((entry) * FH_MAX_PASS_SLOTS + (slot))
 #define FH_PASS_ENTRY_INDEX(pass_entry) ((pass_entry) / FH_MAX_PASS_SLOTS)

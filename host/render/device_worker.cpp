@@ -7,10 +7,6 @@
 
 namespace fh {
 
-// Iterations queued between reads of the device's books: enough that the device is never
-// idle waiting for the host, few enough that finished passes leave soon.
-constexpr int kIterationsPerBatch = 8;
-
 void DeviceWorker::run(const RenderSettings& settings) {
   takePasses();
   while ((returned_ < granted_ || held_) && !settings.stopRequested()) {

@@ -122,7 +122,14 @@ WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, cons
   // Enough passes of every pixel in flight that the wavefront stays full while a pass's
   // longest paths finish: each costs a frame of pass buffers, so only as many as the
   // wavefront needs. Passes of fewer pixels (an adaptive round's) fit more times.
-  const size_t fullPasses = std::min<size_t>(kMostFullPasses, 2 + (2 * wavefront_ + pixels_ - 1) / pixels_);
+  size_t fullPasses = std::min<size_t>(kMostFullPasses, 2 + (2 * wavefront_ + pixels_ - 1) / pixels_);
+  // A megakernel launch ends every path it starts: no long paths outlive it, and a pass is
+  // returned at the end of the batch that starts its last samples. Where a pass outlasts a
+  // batch of launches, the pass after it keeps the device fed until then, and two passes
+  // of entries do (a 4K frame of pass buffers less, 133 MB).
+  if (isMegakernel(strategy_) &&
+      pixels_ >= size_t(kIterationsPerBatch) * FH_MEGAKERNEL_SAMPLES_PER_SLOT * wavefront_)
+    fullPasses = 2;
   // A path's pass_entry holds its entry times FH_MAX_PASS_SLOTS in 32 bits.
   const size_t mostEntries = (size_t(1) << 32) / FH_MAX_PASS_SLOTS;
   if (pixels_ > mostEntries)

@@ -62,6 +62,11 @@ unsigned lanesOf(Strategy s);
 // Whether the strategy runs the stages in one kernel (kernels/megakernel.cl).
 bool isMegakernel(Strategy s);
 
+// Iterations a device worker queues between reads of the device's books
+// (render/device_worker.h): enough that the device is never idle waiting for the host, few
+// enough that finished passes leave soon.
+constexpr int kIterationsPerBatch = 8;
+
 // The default number of paths in flight: 512k on a GPU, fewer on a CPU, where the
 // path state should stay near the caches; never more than two passes of pixels.
 size_t defaultWavefront(const DeviceInfo& device, size_t pixels);
