@@ -297,7 +297,9 @@ void PassPool::mergeInOrder() {
     const bool chooses = settings_.adaptive && pass + 1 == adaptiveChoicePoint(round.begin);
     auto following = chooses ? pixelsOfRoundAfter(round.begin) : nullptr;
     lock.lock();
-    spare_.push_back(std::move(samples));
+    // One spare a worker at most: passes that piled up for the merger (up to its budget,
+    // mergerBehind) leave no frames behind them.
+    if (spare_.size() < done_.size()) spare_.push_back(std::move(samples));
     ++nextToMerge_;
     mergedSamples_ += double(round.size);
     const bool ends = settings_.adaptive && pass + 1 == round.end;
