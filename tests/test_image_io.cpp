@@ -16,6 +16,7 @@
 
 #include "base/error.h"
 #include "image/error_metrics.h"
+#include "base/output_plan.h"
 #include "image/image_io.h"
 #include "test_support.h"
 
@@ -71,19 +72,25 @@ TEST(ImageIo, HdrAndPfmAreFloat) {
 
 TEST(ImageIo, ChecksBeforeRendering) {
   const std::string dir = test::tempDir("img");
-  EXPECT_EQ(checkOutputPath(dir + "/x.EXR", false), ImageEncoding::LinearFloat);
-  EXPECT_EQ(checkOutputPath(dir + "/x.jpg", false), ImageEncoding::Srgb8);
+  // The extension picks the encoding; the place is the output plan's to check (base/output_plan.h).
+  const auto planned = [](const std::string& path, bool force) {
+    OutputPlan plan(force);
+    plan.add(path, "-o");
+    plan.reserve();
+  };
+  EXPECT_EQ(checkImageExtension(dir + "/x.EXR", "-o"), ImageEncoding::LinearFloat);
+  EXPECT_EQ(checkImageExtension(dir + "/x.jpg", "-o"), ImageEncoding::Srgb8);
   try {
-    checkOutputPath(dir + "/x.tga", false);
+    checkImageExtension(dir + "/x.tga", "-o");
     FAIL();
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("-o '" + dir + "/x.tga': unknown image extension '.tga'"),
               std::string::npos);
   }
-  EXPECT_THROW(checkOutputPath(dir + "/no/such/dir/x.png", false), Error);
+  EXPECT_THROW(planned(dir + "/no/such/dir/x.png", false), Error);
   test::writeFile(dir + "/old.png", "x");
-  EXPECT_THROW(checkOutputPath(dir + "/old.png", false), Error);
-  EXPECT_NO_THROW(checkOutputPath(dir + "/old.png", true));
+  EXPECT_THROW(planned(dir + "/old.png", false), Error);
+  EXPECT_NO_THROW(planned(dir + "/old.png", true));
   EXPECT_EQ(firstFreeName(dir + "/old.png"), dir + "/old-1.png");
   EXPECT_EQ(firstFreeName(dir + "/new.png"), dir + "/new.png");
 }

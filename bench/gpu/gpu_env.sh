@@ -1,8 +1,21 @@
-# Sourced by the GPU scripts (run_gpu.sh, run_scale.sh) with $target (a bundle from
-# make_bundle.sh, or a fredholm binary), $out and $log set: probes the machine into
+# Sourced by the GPU scripts (run_gpu.sh, run_scale.sh) with their arguments, [--small]
+# FREDHOLM OUTDIR: sets $small, $target (a bundle from make_bundle.sh, or a fredholm binary),
+# $out and $log (OUTDIR/log.txt, emptied); then probes the machine into
 # $out/probe.txt, points the OpenCL ICD loader at NVIDIA's driver where no vendors file names
 # it, and defines `fredholm` (the command, as an array) and `fh LIMIT ARGS...`, which runs
 # it with a time limit and logs the command and its output to $log.
+small=0
+if [ "${1:-}" = "--small" ]; then small=1; shift; fi
+if [ $# -ne 2 ]; then
+  echo "usage: $0 [--small] FREDHOLM_BUNDLE_OR_BINARY OUTDIR" >&2
+  exit 2
+fi
+target=$1
+out=$2
+mkdir -p "$out" || exit 2
+log="$out/log.txt"
+: >"$log"
+
 # ---- The machine ------------------------------------------------------------------------
 {
   echo "== uname"; uname -a

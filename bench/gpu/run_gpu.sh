@@ -14,18 +14,10 @@
 # 1.1M-triangle scene. OUTDIR/results.json holds it all; OUTDIR/log.txt every command.
 set -uo pipefail
 
-small=0
-if [ "${1:-}" = "--small" ]; then small=1; shift; fi
-if [ $# -ne 2 ]; then
-  echo "usage: $0 [--small] FREDHOLM_BUNDLE_OR_BINARY OUTDIR" >&2
-  exit 2
-fi
-target=$1
-out=$2
-mkdir -p "$out" || exit 2
-log="$out/log.txt"
-: >"$log"
 here=$(cd "$(dirname "$0")" && pwd)
+# The arguments ([--small] FREDHOLM OUTDIR), the machine, its OpenCL driver, and fh.
+# shellcheck source=bench/gpu/gpu_env.sh
+. "$here/gpu_env.sh"
 
 if [ $small -eq 1 ]; then
   size=32; spp=16; sweep_spp=4; sweep="1024 2048 4096"; bench_size=32; repeats=1; big_size=32; big_spp=2
@@ -33,10 +25,6 @@ else
   size=512; spp=1024; sweep_spp=64; sweep="262144 524288 1048576 2097152 4194304"; bench_size=512; repeats=5
   big_size=512; big_spp=64
 fi
-
-# The machine, its OpenCL driver, and fh: fredholm run with a time limit, logged.
-# shellcheck source=bench/gpu/gpu_env.sh
-. "$here/gpu_env.sh"
 
 if ! fh 60 devices; then
   # Say why no platform was found: the ICD loader's own account.

@@ -11,18 +11,8 @@
 # figures; OUTDIR/log.txt every command and its output.
 set -uo pipefail
 
-small=0
-if [ "${1:-}" = "--small" ]; then small=1; shift; fi
-if [ $# -ne 2 ]; then
-  echo "usage: $0 [--small] FREDHOLM_BUNDLE_OR_BINARY OUTDIR" >&2
-  exit 2
-fi
-target=$1
-out=$2
-mkdir -p "$out" || exit 2
-log="$out/log.txt"
-: >"$log"
 here=$(cd "$(dirname "$0")" && pwd)
+# The arguments ([--small] FREDHOLM OUTDIR), the machine, its OpenCL driver, and fh.
 # shellcheck source=bench/gpu/gpu_env.sh
 . "$here/gpu_env.sh"
 

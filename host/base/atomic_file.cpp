@@ -120,15 +120,19 @@ std::string commit(const std::string& temp, const std::string& path, CommitRule 
       throw Error(std::string("cannot rename the temporary file over it: ") + std::strerror(errno));
     return path;
   }
-  const fs::path p(path);
-  const std::string stem = (p.parent_path() / p.stem()).string(), ext = p.extension().string();
   for (int i = 0;; ++i) {
-    const std::string candidate = i == 0 ? path : stem + "-" + std::to_string(i) + ext;
+    const std::string candidate = numberedName(path, i);
     if (renameNoReplace(temp, candidate)) return candidate;
   }
 }
 
 }  // namespace
+
+std::string numberedName(const std::string& path, int n) {
+  if (n == 0) return path;
+  const fs::path p(path);
+  return (p.parent_path() / p.stem()).string() + "-" + std::to_string(n) + p.extension().string();
+}
 
 void reserveTarget(const std::string& path, const std::string& what, CommitRule rule) {
   const std::string temp = temporaryBeside(path);

@@ -38,6 +38,9 @@ void releaseTarget(const std::string& path);
 // Targets reserved with CommitRule::Keep that were written elsewhere: {path, written}.
 std::vector<std::pair<std::string, std::string>> steppedAside();
 
+// NAME.EXT for n = 0, NAME-n.EXT otherwise: where an output steps aside to.
+std::string numberedName(const std::string& path, int n);
+
 // Removes every temporary file this process has open for writing; async-signal-safe, for
 // a signal handler that ends the process at once (the second Ctrl-C).
 void removeTemporariesNow();

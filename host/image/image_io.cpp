@@ -5,7 +5,6 @@
 #ifdef FREDHOLM_HAVE_OIIO
 #include <OpenImageIO/imageio.h>
 #endif
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -80,12 +79,6 @@ float linearToSrgb(float x) {
 
 float srgbToLinear(float x) { return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f); }
 
-ImageEncoding checkOutputPath(const std::string& path, bool force, const std::string& flag) {
-  const ImageEncoding encoding = checkImageExtension(path, flag);
-  checkOutputFile(path, force, flag);
-  return encoding;
-}
-
 ImageEncoding checkImageExtension(const std::string& path, const std::string& flag) {
   const std::string ext = extensionOf(path);
   ImageEncoding encoding;
@@ -101,24 +94,10 @@ ImageEncoding checkImageExtension(const std::string& path, const std::string& fl
   return encoding;
 }
 
-void checkOutputFile(const std::string& path, bool force, const std::string& flag) {
-  const fs::path parent = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
-  std::error_code ec;
-  if (!fs::is_directory(parent, ec)) throw Error(flag + " '" + path + "': directory '" + parent.string() + "' does not exist");
-  if (::access(parent.c_str(), W_OK) != 0)
-    throw Error(flag + " '" + path + "': directory '" + parent.string() + "' is not writable");
-  if (fs::is_directory(path, ec)) throw Error(flag + " '" + path + "': is a directory");
-  if (fs::exists(path, ec) && !force)
-    throw Error(flag + " '" + path + "': file exists (pass --force to overwrite it)");
-}
-
 std::string firstFreeName(const std::string& path) {
   std::error_code ec;
-  if (!fs::exists(path, ec)) return path;
-  const fs::path p(path);
-  const std::string stem = (p.parent_path() / p.stem()).string(), ext = p.extension().string();
-  for (int i = 1;; ++i) {
-    const std::string candidate = stem + "-" + std::to_string(i) + ext;
+  for (int i = 0;; ++i) {
+    const std::string candidate = numberedName(path, i);
     if (!fs::exists(candidate, ec)) return candidate;
   }
 }

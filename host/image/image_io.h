@@ -37,18 +37,10 @@ enum class ImageEncoding { LinearFloat, Srgb8 };
 // unknown extension.
 ImageEncoding checkImageExtension(const std::string& path, const std::string& flag);
 
-// Throws fh::Error (naming the flag) for an unknown extension, a missing or unwritable
-// directory, or an existing file without `force`. Call before rendering.
-ImageEncoding checkOutputPath(const std::string& path, bool force, const std::string& flag = "-o");
-
-// The same checks for any output file (--stats, --json): its directory exists and is
-// writable, it is not a directory, and it does not exist unless `force`.
-void checkOutputFile(const std::string& path, bool force, const std::string& flag);
-
 // The path's extension in lower case (".exr"), which picks the format.
 std::string extensionOf(const std::string& path);
 
-// The first of base.ext, base-1.ext, base-2.ext ... that does not exist.
+// The first of base.ext, base-1.ext, base-2.ext ... that does not exist (numberedName).
 std::string firstFreeName(const std::string& path);
 
 // Writes the image whole or not at all (base/atomic_file.h); returns the path written.
