@@ -15,7 +15,8 @@ PACKAGES=(build-essential cmake ninja-build pkg-config
           libcli11-dev nlohmann-json3-dev
           openmpi-bin libopenmpi-dev   # renders shared by the ranks of an mpirun job
           clang oclgrind   # the portability gates: offline compiles for other targets, a device simulator
-          libclang-rt-14-dev)  # sanitizers and libFuzzer for clang (tests/sanitize.sh)
+          libclang-rt-14-dev   # sanitizers and libFuzzer for clang (tests/sanitize.sh)
+          python3-pip)  # fetches Open Image Denoise (--denoise) from PyPI: install_oidn
 # Optional: Embree for the bench comparison, matplotlib for the charts.
 OPTIONAL_PACKAGES=(libembree-dev python3-matplotlib)
 
@@ -38,6 +39,42 @@ install_packages() {
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends $missing >&2
 }
 
+# Intel Open Image Denoise for --denoise: not in Debian 12, so the library comes from PyPI's
+# pyoidn wheel (pinned by version and hash), unpacked into /opt/oidn/lib with the wheel's own
+# layout (its libraries find each other through $ORIGIN/../lib). fredholm loads it at run
+# time (host/image/denoiser.h); the CPU device alone is installed.
+OIDN_WHEEL=pyoidn-2.5.1.0-py3-none-manylinux2014_x86_64.whl
+OIDN_SHA256=32ad13368f8de1ef63001942ad05b02a00cd732d1206d97f352d3a3f606d823e
+OIDN_DIR=/opt/oidn
+install_oidn() {
+  [ -f "$OIDN_DIR/lib/libOpenImageDenoise.so.2" ] && return 0
+  [ "$(uname -m)" = x86_64 ] || { echo "setup: no Open Image Denoise wheel for $(uname -m): --denoise is off" >&2; return 0; }
+  local sudo="" tmp
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  tmp=$(mktemp -d)
+  echo "setup: installing Intel Open Image Denoise into $OIDN_DIR (from PyPI's pyoidn wheel)" >&2
+  /usr/bin/python3 -m pip download --quiet --no-deps --only-binary=:all: --platform manylinux2014_x86_64 \
+    --dest "$tmp" "pyoidn==2.5.1.0" >&2
+  echo "$OIDN_SHA256  $tmp/$OIDN_WHEEL" | sha256sum --check --quiet
+  /usr/bin/python3 - "$tmp/$OIDN_WHEEL" "$tmp/lib" <<'PY'
+import os, sys, zipfile
+wheel, out = sys.argv[1:]
+keep = ("libOpenImageDenoise.so.2", "libOpenImageDenoise_core.so.", "libOpenImageDenoise_device_cpu.so.",
+        "libtbb.so.12")
+os.makedirs(out)
+with zipfile.ZipFile(wheel) as z:
+    for name in z.namelist():
+        base = os.path.basename(name)
+        if name.startswith("pyoidn/oidn/lib/") and base.startswith(keep):
+            with z.open(name) as src, open(os.path.join(out, base), "wb") as dst:
+                dst.write(src.read())
+PY
+  $sudo mkdir -p "$OIDN_DIR"
+  $sudo rm -rf "$OIDN_DIR/lib"
+  $sudo cp -r "$tmp/lib" "$OIDN_DIR/lib"
+  rm -rf "$tmp"
+}
+
 build() {
   local generator=()
   [ -f build/CMakeCache.txt ] || generator=(-G Ninja)
@@ -48,6 +85,7 @@ build() {
 action=${1:-build}
 [ $# -gt 0 ] && shift
 install_packages
+install_oidn
 build
 case "$action" in
   build) ;;

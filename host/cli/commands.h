@@ -33,6 +33,8 @@ struct RenderOptions {
   std::optional<float> fov;
   std::string aov;
   std::string aovs;  // --aovs: layers written beside the image in one EXR
+  bool denoise = false;       // --denoise: NAME.denoised.EXT beside the image
+  std::string displayServer;  // --display-server HOST:PORT: tev's live view
   std::string checkpoint, resume;  // --checkpoint FILE, --resume FILE
   std::string passes, film;        // --passes A:B (a chunk), --film FILE (the film, for fredholm merge)
   // Under mpirun (host/distributed): the job this process is a rank of; null otherwise.

@@ -86,6 +86,12 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
                         "Layers written beside the image in one EXR, from the same render: albedo, normal "
                         "(first non-specular surface), depth (camera ray), variance (of each pixel's mean), "
                         "spp; e.g. albedo,normal,depth");
+  rendering->add_flag("--denoise", o.denoise,
+                      "Also write NAME.denoised.EXT beside the image -o names: Intel Open Image Denoise's RT "
+                      "filter on the radiance, guided by the first-surface albedo and normal");
+  rendering->add_option("--display-server", o.displayServer,
+                        "Stream the image as it converges to the tev viewer listening at HOST:PORT (tev's "
+                        "default port is 14158); a viewer that is not there or goes away is a warning");
   rendering->add_option("--checkpoint", o.checkpoint,
                         "Save the render so far to FILE every --checkpoint-every seconds and when it ends "
                         "(also on Ctrl-C), to go on from with --resume");

@@ -17,6 +17,7 @@
 #include "cli/flags.h"
 #include "cli/interrupt.h"
 #include "device/devices.h"
+#include "image/denoiser.h"
 #include "image/image_io.h"
 #include "render/checkpoint.h"
 #include "render/render.h"
@@ -187,6 +188,12 @@ void reportDevices(const RenderResult& r) {
     std::cerr << "fredholm: warning: " << r.stats.nonfinite << " samples were NaN or infinite and dropped\n";
 }
 
+// Where --denoise writes: out.exr -> out.denoised.exr, beside the image, never instead of it.
+std::string denoisedName(const std::string& output) {
+  const std::filesystem::path p(output);
+  return (p.parent_path() / p.stem()).string() + ".denoised" + p.extension().string();
+}
+
 // The --aovs layers, parsed and checked against the other flags and the output; picks the
 // default output name (PNG, or EXR with layers) and plans every file the render writes.
 std::vector<std::string> planOutputs(RenderOptions& o, RenderSettings& settings, int rank, OutputPlan& plan) {
@@ -220,6 +227,14 @@ std::vector<std::string> planOutputs(RenderOptions& o, RenderSettings& settings,
     if (!layers.empty() && !o.output.empty() && extensionOf(o.output) != ".exr")
       throw Error("--aovs: layers are written into one EXR; -o '" + o.output + "' is not an .exr file");
     if (!o.statsFile.empty()) plan.add(o.statsFile, "--stats");
+  }
+  if (o.denoise) {
+    if (!o.aov.empty()) throw Error("--denoise works on a render's radiance; --aov renders a debug view");
+    if (o.output.empty())
+      throw Error("--denoise writes NAME.denoised.EXT beside the image: give -o (with --film, no image is written "
+                  "without it)");
+    settings.surfaceAovs = true;  // the denoiser's albedo and normal
+    if (rank == 0) plan.add(denoisedName(o.output), "--denoise", defaultName ? OutputKind::Default : OutputKind::Named);
   }
   plan.reserve();
   return layers;
@@ -279,11 +294,26 @@ RenderResult renderOnEveryRank(const RenderOptions& o, const std::vector<DeviceI
   return render(devices, scene, bvh, camera, settings);
 }
 
-// Writes the image where -o names one and the film for --film; returns what was written.
+// The image's radiance denoised, written with the render's metadata and what denoised it.
+std::string writeDenoised(const std::string& output, const Denoiser& denoiser, const Film& film, const Image& image,
+                          std::map<std::string, std::string> metadata) {
+  const auto start = std::chrono::steady_clock::now();
+  const Image denoised = denoiser.denoise(image, film.albedo(), film.normal());
+  metadata["denoised"] = denoiser.describe();
+  const std::string written = writeImage(denoisedName(output), denoised, metadata);
+  std::cerr << "fredholm: denoised in "
+            << formatSeconds(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count())
+            << " s\n";
+  return written;
+}
+
+// Writes the image where -o names one (and its denoised twin with --denoise) and the film for
+// --film; returns what was written.
 std::string writeOutputs(const RenderOptions& o, const RenderSettings& s, const Film& film, const Image& image,
-                         const std::map<std::string, std::string>& metadata) {
+                         const std::map<std::string, std::string>& metadata, const Denoiser* denoiser) {
   std::string written;
   if (!o.output.empty()) written = writeImage(o.output, image, metadata);
+  if (denoiser) written += " and " + writeDenoised(o.output, *denoiser, film, image, metadata);
   if (!o.film.empty() && film.passes() > 0)
     written += (written.empty() ? "" : " and ") + saveFilm(o.film, film, s.fingerprint, "--film") + " (passes " +
                film.describePasses() + ")";
@@ -339,6 +369,7 @@ int runRender(RenderOptions o) {
   if (o.mpi) checkSharedRender(o, settings, rank);
   OutputPlan plan(o.force);
   const std::vector<std::string> layers = planOutputs(o, settings, rank, plan);
+  const std::unique_ptr<Denoiser> denoiser = o.denoise && rank == 0 ? Denoiser::load() : nullptr;
   const auto devices = selectDevices(listDevices(), o.device);
   if (debugView && devices.size() > 1)
     throw Error("--aov renders on one device, and --device '" + o.device + "' selects " +
@@ -380,7 +411,7 @@ int runRender(RenderOptions o) {
     const int signal = settings.stop->load();
     if (r.film.samples() == 0) throw Interrupted("before any pass was finished; nothing written", signal);
     metadata["incomplete"] = "interrupted by signal " + std::to_string(signal);
-    throw Interrupted("wrote the " + passes + " finished so far to " + writeOutputs(o, settings, r.film, image, metadata) +
+    throw Interrupted("wrote the " + passes + " finished so far to " + writeOutputs(o, settings, r.film, image, metadata, denoiser.get()) +
                           (o.checkpoint.empty() ? "" : " and a checkpoint to " + o.checkpoint +
                                                            " (go on with --resume " + o.checkpoint + ")"),
                       signal);
@@ -388,9 +419,9 @@ int runRender(RenderOptions o) {
   if (!r.complete) {
     metadata["incomplete"] = "every device failed";
     throw Error("every device failed before the render was complete; wrote the " + passes + " finished so far to " +
-                writeOutputs(o, settings, r.film, image, metadata));
+                writeOutputs(o, settings, r.film, image, metadata, denoiser.get()));
   }
-  const std::string written = writeOutputs(o, settings, r.film, image, metadata);
+  const std::string written = writeOutputs(o, settings, r.film, image, metadata, denoiser.get());
   printSummary(o, settings, scene, r, method, spp, seconds, estimatedRelMse);
   plan.finish();
   std::cout << "wrote " << written << "\n";
