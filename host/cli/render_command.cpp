@@ -8,11 +8,13 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "base/atomic_file.h"
 #include "base/output_plan.h"
 #include "base/vec.h"
+#include "display/live_view.h"
 #include "cli/commands.h"
 #include "cli/flags.h"
 #include "cli/interrupt.h"
@@ -367,6 +369,8 @@ int runRender(RenderOptions o) {
   const Aov aov = debugView ? parseAov(o.aov) : Aov::Albedo;
   const int rank = mpiRank(o);
   if (o.mpi) checkSharedRender(o, settings, rank);
+  const std::optional<DisplayAddress> display =
+      o.displayServer.empty() ? std::nullopt : std::optional<DisplayAddress>(parseDisplayAddress(o.displayServer));
   OutputPlan plan(o.force);
   const std::vector<std::string> layers = planOutputs(o, settings, rank, plan);
   const std::unique_ptr<Denoiser> denoiser = o.denoise && rank == 0 ? Denoiser::load() : nullptr;
@@ -387,6 +391,12 @@ int runRender(RenderOptions o) {
   }
   if (settings.resume && rank == 0) reportResume(o, settings);
   plan.checkAgainstInputs();
+  // rank 0's view: its own passes as they merge, then the image of all.
+  std::unique_ptr<LiveView> view;
+  if (display && rank == 0) {
+    view = std::make_unique<LiveView>(*display, o.output.empty() ? o.film : o.output, layers);
+    settings.watcher = view.get();
+  }
   const auto start = std::chrono::steady_clock::now();
   const Bvh bvh = buildBvh(scene);
   const RenderResult r = debugView ? renderDebugView(aov, devices, scene, bvh, camera, settings)
@@ -407,11 +417,16 @@ int runRender(RenderOptions o) {
   if (settings.adaptive) metadata["adaptive"] = "1";
   const Image image = r.film.imageWithLayers(layers);
   const std::string passes = std::to_string(r.film.passes()) + " passes";
+  // The files, and the live view's last frame: the image as written.
+  const auto deliver = [&](const std::map<std::string, std::string>& facts) {
+    if (view) view->showFinal(image);
+    return writeOutputs(o, settings, r.film, image, facts, denoiser.get());
+  };
   if (r.stopped) {
     const int signal = settings.stop->load();
     if (r.film.samples() == 0) throw Interrupted("before any pass was finished; nothing written", signal);
     metadata["incomplete"] = "interrupted by signal " + std::to_string(signal);
-    throw Interrupted("wrote the " + passes + " finished so far to " + writeOutputs(o, settings, r.film, image, metadata, denoiser.get()) +
+    throw Interrupted("wrote the " + passes + " finished so far to " + deliver(metadata) +
                           (o.checkpoint.empty() ? "" : " and a checkpoint to " + o.checkpoint +
                                                            " (go on with --resume " + o.checkpoint + ")"),
                       signal);
@@ -419,9 +434,9 @@ int runRender(RenderOptions o) {
   if (!r.complete) {
     metadata["incomplete"] = "every device failed";
     throw Error("every device failed before the render was complete; wrote the " + passes + " finished so far to " +
-                writeOutputs(o, settings, r.film, image, metadata, denoiser.get()));
+                deliver(metadata));
   }
-  const std::string written = writeOutputs(o, settings, r.film, image, metadata, denoiser.get());
+  const std::string written = deliver(metadata);
   printSummary(o, settings, scene, r, method, spp, seconds, estimatedRelMse);
   plan.finish();
   std::cout << "wrote " << written << "\n";

@@ -9,6 +9,7 @@
 #include "base/error.h"
 #include "render/adaptive.h"
 #include "render/checkpoint.h"
+#include "render/film_watcher.h"
 
 namespace fh {
 namespace {
@@ -290,6 +291,7 @@ void PassPool::mergeInOrder() {
     const Round round = *roundOf(pass);  // the merger alone adds and drops rounds
     lock.unlock();
     film_.addPass(pass, samples, round.list());
+    if (settings_.watcher && settings_.watcher->wantsFrame()) settings_.watcher->show(film_);
     const bool check = settings_.noise > 0.0 && film_.passes() >= kNoiseMinPasses;
     const double estimate = check ? film_.estimatedRelMse() : -1.0;
     if (settings_.ledger) settings_.ledger->finished(pass);

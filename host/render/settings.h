@@ -13,6 +13,7 @@ namespace fh {
 
 struct EnvironmentMap;
 struct Film;
+class FilmWatcher;
 class PassLedger;
 
 enum class Method { PT, NEE, MIS };
@@ -80,6 +81,8 @@ struct RenderSettings {
   // film then holds whichever passes this process rendered, added as they finish (its sums
   // are exact, render/film.h, so the order does not matter but for sumSq's rounding).
   PassLedger* ledger = nullptr;
+  // Shown the film between merged passes when it asks (render/film_watcher.h); null: none.
+  FilmWatcher* watcher = nullptr;
   // Set (non-zero) to stop early, as Ctrl-C does: passes in flight are dropped, those
   // finished are kept. Null: never.
   const std::atomic<int>* stop = nullptr;
