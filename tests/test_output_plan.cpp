@@ -7,6 +7,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <thread>
@@ -180,10 +181,37 @@ TEST(Budgets, AResumedRenderSaysSoAndCountsItsOwnSamples) {
   EXPECT_NE(r.output.find("resuming from '" + dir + "/c.film': passes 0:4 rendered; rendering from pass 4"),
             std::string::npos) << r.output;
   EXPECT_NE(r.output.find("fredholm: " + std::to_string(16 * 16 * 2) + " samples in"), std::string::npos) << r.output;
-  r = test::runFredholm("render --width 16 --height 16 --spp 3 --resume " + dir + "/c.film -o " + dir + "/c.png");
+  r = test::runFredholm("render --width 16 --height 16 --spp 4 --resume " + dir + "/c.film -o " + dir + "/c.png");
   ASSERT_EQ(r.exitCode, 0) << r.output;
-  EXPECT_NE(r.output.find("as many as --spp 3 asks: nothing left to render"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("as many as --spp 4 asks: nothing left to render"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("on no device (nothing left to render)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("fredholm: no samples rendered"), std::string::npos) << r.output;
+  // Fewer than the checkpoint holds: said, and the image keeps them all.
+  r = test::runFredholm("render --width 16 --height 16 --spp 3 --resume " + dir + "/c.film -o " + dir + "/d.png");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("passes 0:4 rendered, more than the 3 --spp asks: nothing left to render, and the image "
+                          "holds all 4"), std::string::npos) << r.output;
+  EXPECT_EQ(metadataOf(dir + "/d.png", "spp"), "4.00");
+}
+
+// The rate the summary gives counts from the end of the first pass, which carries the kernels'
+// build: with empty kernel caches that build dwarfs a small render, and a rate counted from the
+// start (the old figure, samples over the whole time) would be mostly the compiler's.
+TEST(Budgets, RatesCountFromTheEndOfTheFirstPass) {
+  const std::string dir = test::tempDir("budget");
+  const auto r = test::runFredholm("render --width 32 --height 32 --spp 16 -o " + dir + "/r.png",
+                                   "POCL_CACHE_DIR=" + dir + "/pocl FREDHOLM_CACHE_DIR=" + dir + "/programs");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  double total = 0, rate = 0, first = 0;
+  const size_t at = r.output.find("fredholm: 16384 samples in ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  ASSERT_EQ(std::sscanf(r.output.c_str() + at,
+                        "fredholm: 16384 samples in %lfs: %lf Msamples/s after the first pass (the first, with any "
+                        "kernel builds, took %lfs)", &total, &rate, &first), 3) << r.output;
+  EXPECT_LE(first, total);
+  // 15 passes of 1024 samples after the first, in at most the time after it.
+  EXPECT_GE(rate * 1e6 * (total - first), 15 * 1024 * 0.999) << r.output;
+  EXPECT_GT(rate, 16384 / total * 1e-6) << "the rate counts the kernels' build: " << r.output;
 }
 
 // CLI11's own words never reach the user: each parse error names the flag and what it takes.

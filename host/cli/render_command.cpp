@@ -245,11 +245,15 @@ std::vector<std::string> planOutputs(RenderOptions& o, RenderSettings& settings,
 // A resumed render says what it starts from, and when the checkpoint holds every pass asked for.
 void reportResume(const RenderOptions& o, const RenderSettings& settings) {
   const Film& film = *settings.resume;
+  const uint64_t held = film.nextPass(), asked = uint64_t(settings.spp);
   std::cerr << "fredholm: resuming from '" << o.resume << "': passes " << film.describePasses() << " rendered";
-  if (!settings.adaptive && film.nextPass() >= uint64_t(settings.spp))
-    std::cerr << ", as many as --spp " << settings.spp << " asks: nothing left to render\n";
-  else
-    std::cerr << "; rendering from pass " << film.nextPass() << "\n";
+  if (settings.adaptive || held < asked)
+    std::cerr << "; rendering from pass " << held << "\n";
+  else if (held == asked)
+    std::cerr << ", as many as --spp " << asked << " asks: nothing left to render\n";
+  else  // the image keeps every pass the checkpoint holds: samples are never thrown away
+    std::cerr << ", more than the " << asked << " --spp asks: nothing left to render, and the image holds all "
+              << held << "\n";
 }
 
 // This process's rank when it is one of several sharing the render (mpirun), else 0.

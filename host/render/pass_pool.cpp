@@ -39,6 +39,7 @@ PassPool::PassPool(const RenderSettings& s, int workers)
   next_ = nextToMerge_ = firstNew_ = uint32_t(film_.nextPass());
   mergedSamples_ = resumedSamples_ = film_.samples();
   samplesDone_.assign(size_t(workers), 0);
+  clocks_.resize(size_t(workers));
   if (!s.adaptive) {
     addRound(0, nullptr);
   } else {
@@ -149,6 +150,12 @@ void PassPool::done(int worker, uint32_t pass, std::vector<float>& samples) {
   outstanding_[size_t(worker)].erase(pass);
   ++done_[size_t(worker)];
   samplesDone_[size_t(worker)] += roundOf(pass)->size;
+  WorkerClock& clock = clocks_[size_t(worker)];
+  clock.last = std::chrono::steady_clock::now();
+  if (done_[size_t(worker)] == 1) {
+    clock.first = clock.last;
+    clock.samplesAtFirst = samplesDone_[size_t(worker)];
+  }
   pending_[pass].swap(samples);
   changed_.notify_all();
 }
@@ -191,7 +198,7 @@ Film PassPool::finish(bool& complete) {
   pending_.clear();
   spare_.clear();  // a frame of samples each
   if (settings_.ledger) progress_.end();  // other processes may still be rendering
-  else progress_.finish(uint64_t(mergedSamples_ - resumedSamples_), secondsSince(start_));
+  else progress_.finish(uint64_t(mergedSamples_ - resumedSamples_), secondsSince(start_), steadyRate(), firstPassSeconds());
   return std::move(film_);  // not a copy of its sums (64 bytes a pixel): the pool is done with it
 }
 
@@ -342,6 +349,28 @@ std::vector<std::string> PassPool::warnings() const {
   return warnings_;
 }
 
+// Samples a second: each device's from the end of its first pass to the end of its latest,
+// summed over the devices; 0 until one has finished two passes.
+double PassPool::steadyRate() const {
+  double rate = 0.0;
+  for (size_t w = 0; w < clocks_.size(); ++w) {
+    const double seconds = std::chrono::duration<double>(clocks_[w].last - clocks_[w].first).count();
+    if (done_[w] >= 2 && seconds > 0.0) rate += double(samplesDone_[w] - clocks_[w].samplesAtFirst) / seconds;
+  }
+  return rate;
+}
+
+// From the first pass handed out to the first finished (with the kernels' build); 0: none yet.
+double PassPool::firstPassSeconds() const {
+  double first = 0.0;
+  for (size_t w = 0; w < clocks_.size(); ++w) {
+    if (done_[w] == 0) continue;
+    const double seconds = std::chrono::duration<double>(clocks_[w].first - start_).count();
+    first = first > 0.0 ? std::min(first, seconds) : seconds;
+  }
+  return first;
+}
+
 void PassPool::showProgress() {
   const double elapsed = secondsSince(start_);
   const bool timed = settings_.seconds > 0.0, noisy = settings_.noise > 0.0;
@@ -353,7 +382,8 @@ void PassPool::showProgress() {
   const uint64_t samples = settings_.adaptive ? sampleBudget_ - uint64_t(resumedSamples_) : passes * film_.pixels();
   progress_.update(uint64_t(mergedSamples_ - resumedSamples_) + elsewhere * film_.pixels(), timed || noisy ? 0 : samples, elapsed,
                    noisy ? std::min(1.0, std::max(noiseShare, timed ? elapsed / settings_.seconds : 0.0))
-                         : timed ? std::min(1.0, elapsed / settings_.seconds) : 0.0);
+                         : timed ? std::min(1.0, elapsed / settings_.seconds) : 0.0,
+                   steadyRate());
 }
 
 }  // namespace fh

@@ -69,6 +69,8 @@ class PassPool : public PassSource {
   std::shared_ptr<const PixelList> pixelsOfRoundAfter(uint32_t begin) const;
   void recordRounds();
   bool outOfTime() const;
+  double steadyRate() const;        // under the lock
+  double firstPassSeconds() const;  // under the lock
   void mergeInOrder();
   void stopMerging();
   void showProgress();
@@ -89,6 +91,14 @@ class PassPool : public PassSource {
   std::shared_ptr<const PixelList> everyPixel_;  // a checkpoint's list for rounds of every pixel
   uint64_t sampleBudget_ = 0, samplesHanded_ = 0;  // an adaptive render's
   std::vector<uint64_t> samplesDone_;
+  // Per worker: when its first and latest passes finished, and its samples at the first. The
+  // first pass carries the kernels' build (PoCL compiles at the first launch): rates count
+  // from its end.
+  struct WorkerClock {
+    std::chrono::steady_clock::time_point first, last;
+    uint64_t samplesAtFirst = 0;
+  };
+  std::vector<WorkerClock> clocks_;
   std::deque<uint32_t> requeued_;
   std::vector<std::set<uint32_t>> outstanding_;
   std::vector<uint64_t> done_;
