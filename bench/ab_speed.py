@@ -2,7 +2,11 @@
 """Render speed of two fredholm binaries side by side, alternated in one run (this machine
 drifts by tens of percent between runs, so only interleaved figures compare).
 
-  bench/ab_speed.py OLD NEW [--rounds 5] -- render ARGS...
+  bench/ab_speed.py OLD NEW [--rounds 5] [--old-args "..."] [--new-args "..."] -- render ARGS...
+
+OLD and NEW may be the same binary with different flags: --old-args and --new-args are added
+to each one's command (e.g. --new-args "--display-server 127.0.0.1:14158" with
+bench/tev_sink.py listening: a render with a live viewer attached against one without).
 
 Each round renders ARGS with OLD then NEW (the order swapped every other round), reads
 samples/s from --stats and times the whole process (start-up, scene, BVH and kernel set-up
@@ -12,13 +16,13 @@ The first render of each binary is a warm-up (kernel compilation) and is not cou
 import argparse, json, os, statistics, subprocess, sys, tempfile, time
 
 
-def render(binary, args, workdir, tag):
+def render(binary, args, workdir, tag, extra=()):
     out, stats = os.path.join(workdir, tag + ".pfm"), os.path.join(workdir, tag + ".json")
     for path in (out, stats):
         if os.path.exists(path):
             os.remove(path)
     start = time.monotonic()
-    subprocess.run([binary] + args + ["-o", out, "--stats", stats], check=True,
+    subprocess.run([binary] + args + list(extra) + ["-o", out, "--stats", stats], check=True,
                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     wall = time.monotonic() - start
     with open(stats) as f:
@@ -35,17 +39,20 @@ def main():
     parser.add_argument("old")
     parser.add_argument("new")
     parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--old-args", default="")
+    parser.add_argument("--new-args", default="")
     opts = parser.parse_args(argv[:split])
+    extras = {"old": opts.old_args.split(), "new": opts.new_args.split()}
     args = argv[split + 1:]
     speeds = {"old": [], "new": []}  # (stats samples/s, samples per process second)
     binaries = {"old": opts.old, "new": opts.new}
     with tempfile.TemporaryDirectory() as workdir:
         for tag in ("old", "new"):
-            render(binaries[tag], args, workdir, tag)  # warm-up
+            render(binaries[tag], args, workdir, tag, extras[tag])  # warm-up
         for r in range(opts.rounds):
             for tag in (("old", "new") if r % 2 == 0 else ("new", "old")):
-                speeds[tag].append(render(binaries[tag], args, workdir, tag))
-    print("fredholm " + " ".join(args))
+                speeds[tag].append(render(binaries[tag], args, workdir, tag, extras[tag]))
+    print("fredholm " + " ".join(args) + "".join(f"  [{t}: {' '.join(e)}]" for t, e in extras.items() if e))
     medians = {}
     for tag in ("old", "new"):
         rate = [s for s, _ in speeds[tag]]

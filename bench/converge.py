@@ -1,11 +1,13 @@
 #!/usr/bin/python3
-"""Error against render time for pt, nee and mis: renders a scene at 1, 2, 4, ... spp with
+"""Error against render time for pt, nee and mis (and mis+denoise: mis with --denoise, the
+denoised image measured and the denoiser's time added): renders a scene at 1, 2, 4, ... spp with
 each method, measures each image against a reference (`fredholm compare`: relMSE, RMSE,
 MAE), and writes a CSV and a log-log chart of relMSE against seconds, with a slope -1
 guide (an unbiased estimator's relMSE falls as 1/time).
 
 usage: bench/converge.py [SCENE.obj] [--out DIR] [--width W] [--height H] [--max-spp N]
-                         [--ref REF.exr | --ref-spp N] [--methods pt,nee,mis] [-- RENDER FLAGS]
+                         [--ref REF.exr | --ref-spp N] [--methods pt,nee,mis] [--name NAME]
+                         [-- RENDER FLAGS]
 
 Without --ref, the reference is a long `mis` render of fredholm itself (--ref-spp samples,
 default 4096): it cannot reveal a bias fredholm shares with itself, and its own noise is
@@ -15,6 +17,7 @@ import argparse
 import csv
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -30,17 +33,58 @@ FREDHOLM = os.path.join(ROOT, "build", "fredholm")
 
 
 def render(scene, out, spp, method, seed, args, extra):
+    """Renders; returns the --stats JSON, and for mis+denoise the denoised image's path and the
+    render's seconds with the denoiser's added."""
+    denoise = method == "mis+denoise"
     cmd = [FREDHOLM, "render"] + ([scene] if scene else []) + [
-        "--width", str(args.width), "--height", str(args.height), "--spp", str(spp), "--method", method,
-        "--seed", str(seed), "-o", out, "--stats", out + ".json", "--force"] + extra
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        "--width", str(args.width), "--height", str(args.height), "--spp", str(spp),
+        "--method", "mis" if denoise else method, "--seed", str(seed), "-o", out, "--stats", out + ".json",
+        "--force"] + (["--denoise"] if denoise else []) + extra
+    run = subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     with open(out + ".json") as f:
-        return json.load(f)
+        stats = json.load(f)
+    if denoise:
+        took = re.search(r"fredholm: denoised in ([0-9.]+) s", run.stderr)
+        stats["seconds"] += float(took.group(1))
+        stats["image"] = out[:-len(".exr")] + ".denoised.exr"
+    return stats
 
 
 def compare(image, reference):
     out = subprocess.run([FREDHOLM, "compare", image, reference], check=True, capture_output=True, text=True)
     return json.loads(out.stdout)
+
+
+def crossover(rows, a, b):
+    """Where b's relMSE-against-time curve (log-log, piecewise linear) last rises above a's for
+    good, after being below it: (seconds, relMSE), or None (b below at the end, or never below)."""
+    import math
+
+    def curve(m):
+        return sorted((math.log(r["seconds"]), math.log(r["relMSE"])) for r in rows if r["method"] == m)
+
+    def at(points, t):
+        for (t0, e0), (t1, e1) in zip(points, points[1:]):
+            if t0 <= t <= t1:
+                return e0 + (e1 - e0) * (t - t0) / (t1 - t0) if t1 > t0 else e0
+        return None
+
+    ca, cb = curve(a), curve(b)
+    if len(ca) < 2 or len(cb) < 2:
+        return None
+    lo, hi = max(ca[0][0], cb[0][0]), min(ca[-1][0], cb[-1][0])
+    steps = 400
+    previous, last = None, None
+    for i in range(steps + 1):
+        t = lo + (hi - lo) * i / steps
+        ea, eb = at(ca, t), at(cb, t)
+        if ea is None or eb is None:
+            continue
+        below = eb < ea
+        if previous is True and not below:
+            last = (math.exp(t), math.exp(ea))
+        previous = below
+    return last if previous is False else None
 
 
 def main():
@@ -58,15 +102,26 @@ def main():
     p.add_argument("--ref")
     p.add_argument("--ref-spp", type=int, default=4096)
     p.add_argument("--methods", default="pt,nee,mis")
+    p.add_argument("--name", help="the CSV's and chart's name (default: the scene's)")
+    p.add_argument("--from-csv", help="chart an earlier run's CSV again, rendering nothing")
     args = p.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
-    name = os.path.splitext(os.path.basename(args.scene))[0].replace(":", "-") if args.scene else "cornell-box"
+    scene_name = os.path.splitext(os.path.basename(args.scene))[0].replace(":", "-") if args.scene else "cornell-box"
+    name = args.name or scene_name
 
     reference = args.ref
+    if args.from_csv:
+        with open(args.from_csv) as f:
+            rows = [{**r, "spp": int(r["spp"]), "seconds": float(r["seconds"]), "relMSE": float(r["relMSE"])}
+                    for r in csv.DictReader(f)]
+        return chart(rows, name, args)
     if not reference:
-        reference = os.path.join(args.out, f"{name}-reference.exr")
-        stats = render(args.scene, reference, args.ref_spp, "mis", 1000, args, extra)
-        print(f"reference: mis, {args.ref_spp} spp, {stats['seconds']:.1f} s -> {reference}")
+        reference = os.path.join(args.out, f"{scene_name}-reference-{args.ref_spp}.exr")
+        if os.path.exists(reference):  # the same scene, size and spp: made by an earlier chart
+            print(f"reference: {reference} (kept)")
+        else:
+            stats = render(args.scene, reference, args.ref_spp, "mis", 1000, args, extra)
+            print(f"reference: mis, {args.ref_spp} spp, {stats['seconds']:.1f} s -> {reference}")
 
     rows = []
     for method in args.methods.split(","):
@@ -77,12 +132,16 @@ def main():
         while spp <= args.max_spp:
             image = os.path.join(args.out, f"{name}-{method}-{spp}.exr")
             stats = render(args.scene, image, spp, method, spp, args, extra)
-            err = compare(image, reference)
+            err = compare(stats.get("image", image), reference)
             rows.append({"scene": name, "method": method, "spp": spp, "seconds": stats["seconds"],
                          "relMSE": err["relmse"], "RMSE": err["rmse"], "MAE": err["mae"]})
             print(f"{method:4s} {spp:6d} spp {stats['seconds']:8.2f} s  relMSE {err['relmse']:.3e}")
             spp *= 2
 
+    chart(rows, name, args)
+
+
+def chart(rows, name, args):
     table = os.path.join(args.out, f"{name}.csv")
     with open(table, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
@@ -90,7 +149,8 @@ def main():
         w.writerows(rows)
 
     fig, ax = plt.subplots(figsize=(6, 4.5))
-    for method, color in (("pt", "tab:blue"), ("nee", "tab:orange"), ("mis", "tab:green")):
+    for method, color in (("pt", "tab:blue"), ("nee", "tab:orange"), ("mis", "tab:green"),
+                          ("mis+denoise", "tab:red")):
         pts = [r for r in rows if r["method"] == method]
         if pts:
             ax.loglog([r["seconds"] for r in pts], [r["relMSE"] for r in pts], "o-", color=color, label=method)
@@ -98,19 +158,27 @@ def main():
     t0, e0 = mis[0]["seconds"], mis[0]["relMSE"]
     ts = [t0, mis[-1]["seconds"]]
     ax.loglog(ts, [e0 * t0 / t for t in ts], "k--", lw=0.8, label="slope -1")
+    crossing = crossover(rows, "mis", "mis+denoise")
+    if crossing:
+        ax.axvline(crossing[0], color="tab:red", ls=":", lw=1, label=f"denoising stops paying ({crossing[0]:.1f} s)")
     ax.set_xlabel("render time (s)")
     ax.set_ylabel("relMSE")
     ax.set_title(f"{name}, {args.width}x{args.height}", fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    chart = os.path.join(args.out, f"{name}.png")
-    fig.savefig(chart, dpi=110)
+    image = os.path.join(args.out, f"{name}.png")
+    fig.savefig(image, dpi=110)
 
     # relMSE at equal time: each method's curve read at the longest time all reached.
     target, values = equal_time(rows)
     print(f"relMSE at {target:.2f} s: " + ", ".join(f"{m} {v:.3e}" for m, v in values.items()))
-    print(f"wrote {table} and {chart}")
+    if crossing:
+        print(f"mis+denoise stops paying at {crossing[0]:.2f} s (relMSE {crossing[1]:.3e}): beyond it the "
+              "denoiser's bias exceeds the noise it removes")
+    elif any(r["method"] == "mis+denoise" for r in rows):
+        print("mis+denoise: no crossover within the chart's times")
+    print(f"wrote {table} and {image}")
 
 
 if __name__ == "__main__":

@@ -4,7 +4,7 @@
 #     suites (ctest -L fast) and each libFuzzer target for about FUZZ_SECONDS over a copy of
 #     the seed corpus, failing on any crash, hang (> 2 s per input) or memory blow-up;
 #  2. a ThreadSanitizer build that runs the multi-device suites (several devices, a device
-#     failing mid-render).
+#     failing mid-render) and the live view's threads in one process.
 # Build trees: build-asan/ and build-tsan/. FUZZ_SECONDS (default 60) sets the fuzzing time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -51,8 +51,8 @@ fuzz image_read image 200
 fuzz checkpoint checkpoint 1000
 fuzz bvh_build bvh 2000
 
-echo "sanitize: ThreadSanitizer, multi-device suites" >&2
+echo "sanitize: ThreadSanitizer, multi-device suites and the live view" >&2
 configure build-tsan thread
-cmake --build build-tsan --parallel "$(nproc)" --target fredholm test_multi_device
-tests/run_ctest.sh build-tsan -R "TwoDevices|MultiDeviceCli"
+cmake --build build-tsan --parallel "$(nproc)" --target fredholm test_multi_device test_display
+tests/run_ctest.sh build-tsan -R "TwoDevices|MultiDeviceCli|LiveView.InProcess"
 echo "sanitize: done in $((SECONDS - start)) s" >&2

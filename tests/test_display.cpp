@@ -16,7 +16,9 @@
 #include <mutex>
 #include <thread>
 
+#include "display/live_view.h"
 #include "image/image_io.h"
+#include "render/film.h"
 #include "test_support.h"
 
 namespace fh {
@@ -218,6 +220,43 @@ TEST(LiveView, AViewerThatLeavesOrIsAbsentChangesNothing) {
   }
   std::lock_guard<std::mutex> lock(leaving.mutex);
   EXPECT_EQ(leaving.packets, 3);
+}
+
+// In one process (the sanitizer builds run this): a merger adding passes as fast as it can and
+// offering each to the view, the sender taking frames on its own thread, then the final image.
+TEST(LiveView, InProcessFramesFollowTheFilmAndTheFinalImageIsLast) {
+  Receiver viewer;
+  const int w = 40, h = 30;
+  Film film(w, h);
+  Image final;
+  int offered = 0;
+  const auto start = std::chrono::steady_clock::now();
+  double seconds = 0;
+  {
+    LiveView view(parseDisplayAddress(viewer.address()), "in-process", {});
+    for (int pass = 0; pass < 300; ++pass) {
+      std::vector<float> samples(size_t(w) * size_t(h) * 4, 1.f);
+      for (size_t p = 0; p < samples.size(); p += 4) samples[p] = float((p / 4 + size_t(pass)) % 5);
+      film.addPass(samples);
+      if (view.wantsFrame()) {
+        view.show(film);
+        ++offered;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    final = film.image();
+    view.showFinal(final);
+  }  // the view closes once the final image is sent
+  std::lock_guard<std::mutex> lock(viewer.mutex);
+  EXPECT_GE(offered, 2);
+  EXPECT_LE(offered, int(seconds / 0.25) + 1) << "frames at most four a second, in " << seconds << " s";
+  // Each frame offered is sent, and the final one (which may replace the last offered, not yet taken).
+  EXPECT_GE(int(viewer.frameStarts.size()), offered);
+  EXPECT_LE(int(viewer.frameStarts.size()), offered + 1);
+  const ViewerImage& shown = viewer.images.at("in-process");
+  for (size_t p = 0; p < final.rgb.size() / 3; ++p)
+    ASSERT_EQ(shown.channels.at("R")[p], final.rgb[3 * p]) << "pixel " << p;
 }
 
 TEST(LiveView, AddressesAreCheckedBeforeWork) {

@@ -199,7 +199,7 @@ TEST(Budgets, AResumedRenderSaysSoAndCountsItsOwnSamples) {
 // start (the old figure, samples over the whole time) would be mostly the compiler's.
 TEST(Budgets, RatesCountFromTheEndOfTheFirstPass) {
   const std::string dir = test::tempDir("budget");
-  const auto r = test::runFredholm("render --width 32 --height 32 --spp 16 -o " + dir + "/r.png",
+  const auto r = test::runFredholm("render --width 32 --height 32 --spp 16 -o " + dir + "/r.png --stats " + dir + "/r.json",
                                    "POCL_CACHE_DIR=" + dir + "/pocl FREDHOLM_CACHE_DIR=" + dir + "/programs");
   ASSERT_EQ(r.exitCode, 0) << r.output;
   double total = 0, rate = 0, first = 0;
@@ -212,6 +212,10 @@ TEST(Budgets, RatesCountFromTheEndOfTheFirstPass) {
   // 15 passes of 1024 samples after the first, in at most the time after it.
   EXPECT_GE(rate * 1e6 * (total - first), 15 * 1024 * 0.999) << r.output;
   EXPECT_GT(rate, 16384 / total * 1e-6) << "the rate counts the kernels' build: " << r.output;
+  // --stats gives the same figures (the line rounds them).
+  const auto stats = test::readJson(dir + "/r.json");
+  EXPECT_NEAR(stats["steady_samples_per_second"].get<double>() * 1e-6, rate, 0.006);
+  EXPECT_NEAR(stats["first_pass_seconds"].get<double>(), first, 0.006);
 }
 
 // CLI11's own words never reach the user: each parse error names the flag and what it takes.

@@ -174,6 +174,16 @@ void PassPool::fail(int worker) {
   changed_.notify_all();
 }
 
+double PassPool::samplesPerSecondAfterFirstPass() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return steadyRate();
+}
+
+double PassPool::secondsToFirstPass() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return firstPassSeconds();
+}
+
 uint64_t PassPool::passesDone(int worker) const {
   std::lock_guard<std::mutex> lock(mutex_);
   return done_[size_t(worker)];

@@ -42,6 +42,10 @@ class PassPool : public PassSource {
   void fail(int worker) override;
 
   uint64_t passesDone(int worker) const;
+  // Samples a second after each worker's first pass, summed (0: none finished two); and the
+  // seconds from the first pass handed out to the first finished.
+  double samplesPerSecondAfterFirstPass() const;
+  double secondsToFirstPass() const;
   uint64_t samplesDone(int worker) const;
   // Ends the render: saves the checkpoint (the passes merged in order), merges whatever
   // finished out of order (passes lost with every device leave gaps: the film records which

@@ -123,6 +123,8 @@ class Render {
     for (const auto& w : pool_.warnings()) result.warnings.push_back(w);
     RenderStats& st = result.stats;
     st.seconds = seconds;
+    st.steadySamplesPerSecond = pool_.samplesPerSecondAfterFirstPass();
+    st.firstPassSeconds = pool_.secondsToFirstPass();
     st.devices = shares_;
     const auto lastEnd = *std::max_element(ends_.begin(), ends_.end());
     for (size_t i = 0; i < devices_.size(); ++i) {

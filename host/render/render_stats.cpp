@@ -56,6 +56,8 @@ std::string statsJson(const RenderStats& st, const RenderSettings& s) {
       {"samples", st.samples},
       {"seconds", st.seconds},
       {"samples_per_second", st.seconds > 0 ? double(st.samples) / st.seconds : 0.0},
+      {"steady_samples_per_second", st.steadySamplesPerSecond},
+      {"first_pass_seconds", st.firstPassSeconds},
       {"nonfinite_samples", st.nonfinite},
       {"devices", devicesJson(st)},
       {"method", methodName(s.method)},

@@ -32,6 +32,9 @@ struct RenderStats {
   std::vector<RankShare> ranks;
   uint64_t samples = 0, nonfinite = 0;
   double seconds = 0.0;
+  // Samples a second after each device's first pass (which carries the kernels' build),
+  // summed over the devices (0: none finished two passes), and when the first pass ended.
+  double steadySamplesPerSecond = 0.0, firstPassSeconds = 0.0;
   uint64_t cameraRays = 0, bounceRays = 0, shadowRays = 0;
   size_t wavefront = 0;  // paths in flight, over all devices
   uint64_t iterations = 0;
