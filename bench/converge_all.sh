@@ -1,20 +1,20 @@
 #!/bin/sh
 # Every error-against-time chart of bench/RESULTS.md and the method x scene table, from a
 # fresh clone (after ./setup.sh build; ../shared/scenes beside the repository for the
-# archive's scenes). About 8 minutes on 2 cores. CSVs and charts land in bench/convergence/,
+# archive's scenes). About 8 minutes on 2 cores. CSVs and charts land in bench/results/convergence/,
 # images and references in bench/out/converge/.
 set -eu
 cd "$(dirname "$0")/.."
 out=bench/out/converge
 shared=../shared/scenes
-mkdir -p "$out" bench/convergence
+mkdir -p "$out" bench/results/convergence
 
 chart() {  # chart NAME converge.py-arguments...
   name=$1
   shift
   echo "== $name"
   bench/converge.py "$@" --out "$out"
-  cp "$out/$name.csv" "$out/$name.png" bench/convergence/
+  cp "$out/$name.csv" "$out/$name.png" bench/results/convergence/
 }
 
 # The closed-form scene against its exact image.
@@ -32,4 +32,4 @@ if [ -d "$shared" ]; then
 else
   echo "($shared not found: the archive's scenes are left out)"
 fi
-/usr/bin/python3 bench/converge_table.py bench/convergence
+/usr/bin/python3 bench/converge_table.py bench/results/convergence

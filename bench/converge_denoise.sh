@@ -5,18 +5,18 @@
 # where the denoiser's bias exceeds the noise it removes, is printed and marked on each chart.
 # After ./setup.sh build (which installs Open Image Denoise); about 25 minutes on 2 cores.
 #   bench/converge_denoise.sh [VEACH_MIS.obj]
-# CSVs and charts land in bench/convergence/denoise/, images and references in bench/out/converge/.
+# CSVs and charts land in bench/results/convergence/denoise/, images and references in bench/out/converge/.
 set -eu
 cd "$(dirname "$0")/.."
 out=bench/out/converge
-mkdir -p "$out" bench/convergence/denoise
+mkdir -p "$out" bench/results/convergence/denoise
 
 chart() {  # chart NAME converge.py-arguments...
   name=$1
   shift
   echo "== $name"
   bench/converge.py "$@" --methods mis,mis+denoise --name "$name" --out "$out"
-  cp "$out/$name.csv" "$out/$name.png" bench/convergence/denoise/
+  cp "$out/$name.csv" "$out/$name.png" bench/results/convergence/denoise/
 }
 
 chart denoise-cornell-box --ref-spp 32768 --max-spp 4096

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """The "method x scene -> relMSE at equal time" table from the CSVs bench/converge.py writes.
 
-usage: bench/converge_table.py [DIR]     (default bench/convergence)
+usage: bench/converge_table.py [DIR]     (default bench/results/convergence)
 
 For each scene, every method's relMSE is read off its error-against-time curve (log-log
 interpolation) at the longest time every method reached, and printed as a Markdown table
@@ -44,7 +44,7 @@ def equal_time(rows):
 
 
 def main():
-    folder = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(os.path.abspath(__file__)),
+    folder = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(os.path.abspath(__file__)), "results",
                                                                 "convergence")
     print("| scene | time | " + " | ".join(f"`{m}` relMSE (× best)" for m in METHODS) + " |")
     print("|---|---|" + "---|" * len(METHODS))

@@ -11,7 +11,7 @@ Writes, into OUT:
     with a camera that sees the blob's shadow.
 Then runs bench/converge.py on it with `--env-map sun-sky.exr` (reference: a long mis render)
 and prints relMSE at equal time per method; the CSV and chart (OUT/sun-blob.csv, .png) are
-copied to bench/convergence/. Needs a build
+copied to bench/results/convergence/. Needs a build
 (build/fredholm and the test scenes), Debian's python3-numpy, python3-matplotlib and oiiotool.
 """
 import argparse
@@ -103,7 +103,7 @@ def main():
                     "--width", str(args.width), "--height", str(args.height), "--max-spp", str(args.max_spp),
                     "--ref-spp", str(args.ref_spp), "--", "--env-map", env], check=True)
     for ext in (".csv", ".png"):
-        shutil.copy(os.path.join(args.out, "sun-blob" + ext), os.path.join(ROOT, "bench", "convergence"))
+        shutil.copy(os.path.join(args.out, "sun-blob" + ext), os.path.join(ROOT, "bench", "results", "convergence"))
 
 
 if __name__ == "__main__":

@@ -5,7 +5,7 @@ same axes, each image measured against one long reference with Mitsuba's compare
 (relMSE with epsilon 1e-2, the reference box-downsampled if larger).
 
   bench/peer_error.py --ref REF.exr [--spp 4,16,64,256] [--methods mis,nee,pt]
-                      [--mitsuba-python /opt/mi-venv/bin/python] [--out bench/peers]
+                      [--mitsuba-python /opt/mi-venv/bin/python] [--out bench/results/peers]
                       [-- EXTRA fredholm render flags]
 
 Then, at equal time, each fredholm method renders with --time set to the seconds Mitsuba
@@ -72,7 +72,7 @@ def main():
     ap.add_argument("--spp", default="4,16,64,256")
     ap.add_argument("--methods", default="mis,nee,pt")
     ap.add_argument("--mitsuba-python", default="/opt/mi-venv/bin/python")
-    ap.add_argument("--out", default=os.path.join(ROOT, "bench", "peers"))
+    ap.add_argument("--out", default=os.path.join(ROOT, "bench", "results", "peers"))
     ap.add_argument("--equal-time-rounds", type=int, default=0)
     opts = ap.parse_args(argv)
     os.makedirs(opts.out, exist_ok=True)

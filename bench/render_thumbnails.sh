@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # Renders the README's thumbnails of the shared scenes (../shared/scenes) into
-# bench/thumbnails/, small and with enough samples to judge the materials.
+# bench/results/thumbnails/, small and with enough samples to judge the materials.
 # usage: bench/render_thumbnails.sh [SPP]   (run after ./setup.sh build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 spp=${1:-256}
 scenes=${FREDHOLM_SCENES:-../shared/scenes}
-out=bench/thumbnails
+out=bench/results/thumbnails
 mkdir -p "$out"
 render() {  # name obj width height [extra flags]
   local name=$1 obj=$2 w=$3 h=$4

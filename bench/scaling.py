@@ -4,9 +4,9 @@
 Runs `fredholm bench spheres:N` for N from 1e2 to 1e7 (generated scenes: a floor under a
 grid of bumped spheres), one process per size so each starts clean, and charts Mrays/s per
 ray kind, BVH build seconds and bytes per triangle against the triangle count, fredholm and
-Embree on the same axes. Writes bench/scaling.json and bench/scaling.png.
+Embree on the same axes. Writes bench/results/scaling.json and bench/results/scaling.png.
 
-  bench/scaling.py [--sizes 1e2,1e3,...] [--repeats 5]
+  bench/results/scaling.py [--sizes 1e2,1e3,...] [--repeats 5]
 """
 import argparse
 import json
@@ -22,7 +22,7 @@ def main():
     p.add_argument("--binary", default=os.path.join(ROOT, "build", "fredholm"))
     p.add_argument("--sizes", default="1e2,3e2,1e3,3e3,1e4,3e4,1e5,3e5,1e6,3e6,1e7")
     p.add_argument("--repeats", type=int, default=5)
-    p.add_argument("--out", default=os.path.join(ROOT, "bench", "scaling"))
+    p.add_argument("--out", default=os.path.join(ROOT, "bench", "results", "scaling"))
     p.add_argument("--replot", action="store_true", help="only redraw the chart from OUT.json")
     a = p.parse_args()
     scenes, records = [], []
