@@ -1,7 +1,9 @@
 // BSDFs on the device: the sampling of every smooth lobe against its pdf (chi-square
 // goodness of fit, as Mitsuba's chi2 test), energy (the estimated albedo never exceeds
 // one), and white furnaces: a lossless object (white diffuse, perfect mirror, clear glass)
-// inside a uniformly emitting, non-reflecting enclosure is invisible.
+// inside a uniformly emitting, non-reflecting enclosure is invisible. And the model itself
+// against independent values: the glossy lobe's value and directional albedo against the
+// published formulas, glass's reflectance against Fresnel's equations.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -34,6 +36,13 @@ __kernel void sample_bsdf(__global const GpuMaterial* m, float4 wo, uint seed, _
                                    random_float((luint)(seed), i, (luint)(1)), random_float((luint)(seed), i, (luint)(2)));
   scatter_xyzw(wi_pdf, i, s.wi, s.pdf, lanes_mask(true));
   scatter_xyzw(weight, i, s.weight, (lfloat)(0.0f), lanes_mask(true));
+}
+__kernel void eval_bsdf(__global const GpuMaterial* m, float4 wo, __global const float4* wi, __global float4* f) {
+  const luint i = lane_positions(get_global_id(0) * FH_LANES);
+  const MaterialLanes material = material_lanes(m, (lint)(0));
+  const Bsdf b = material_bsdf(&material);
+  const lvec3 value = bsdf_eval(&b, v3_uniform((float3)(0.0f, 0.0f, 1.0f)), v3_uniform(wo.xyz), gather_xyz(wi, i));
+  scatter_xyzw(f, i, value, (lfloat)(0.0f), lanes_mask(true));
 }
 __kernel void pdf_bsdf(__global const GpuMaterial* m, float4 wo, __global const float4* wi, __global float* pdf) {
   const luint i = lane_positions(get_global_id(0) * FH_LANES);
@@ -121,6 +130,33 @@ class BsdfOnDevice : public ::testing::Test {
     std::vector<float> p(n);
     FH_CL(dc.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * 4, p.data()));
     return p;
+  }
+
+  // f(wo, wi) for each direction (x, y, z, unused) in `dirs`: red channel only, both strategies.
+  std::vector<float> eval(const gpu::GpuMaterial& m, const float3& wo, const std::vector<float>& dirs) {
+    const std::vector<float> one = eval(programs[0], 1, m, wo, dirs), eight = eval(programs[1], 8, m, wo, dirs);
+    EXPECT_EQ(one, eight) << "one lane and eight disagree";
+    return one;
+  }
+  std::vector<float> eval(const cl::Program& program, size_t lanes, const gpu::GpuMaterial& m, const float3& wo,
+                          const std::vector<float>& dirs) {
+    const size_t n = dirs.size() / 4;
+    EXPECT_EQ(0u, n % lanes);
+    cl::Buffer mb = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, sizeof m, "material", &m);
+    cl::Buffer d = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, n * 16, "dirs", dirs.data());
+    cl::Buffer out = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, n * 16, "f");
+    cl::Kernel k = createKernel(program, "eval_bsdf");
+    const cl_float4 w{{wo[0], wo[1], wo[2], 0.f}};
+    FH_CL(k.setArg(0, mb));
+    FH_CL(k.setArg(1, w));
+    FH_CL(k.setArg(2, d));
+    FH_CL(k.setArg(3, out));
+    FH_CL(dc.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n / lanes)));
+    std::vector<float> f(n * 4);
+    FH_CL(dc.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * 16, f.data()));
+    std::vector<float> red(n);
+    for (size_t i = 0; i < n; ++i) red[i] = f[4 * i];
+    return red;
   }
 };
 
@@ -241,6 +277,143 @@ TEST_F(BsdfOnDevice, GlassReflectsAndRefractsByFresnel) {
   // Leaving the glass beyond the critical angle (41.8 degrees): total internal reflection.
   const Samples inside = sample(m, {std::sin(0.9f), 0.f, -std::cos(0.9f)}, 4096);
   for (size_t i = 0; i < 4096; ++i) EXPECT_LT(inside.wiPdf[4 * i + 2], 0.f) << "not reflected back inside";
+}
+
+// ---- The model against independent values ----
+// Sampling against the pdf cannot see a wrong model that is sampled consistently (a lost
+// cosine, a wrong Fresnel exponent), so the lobes are also held to the published formulas,
+// written out here again in double precision: GGX's D and the height-correlated Smith
+// masking-shadowing (Walter et al. 2007, Heitz 2014), Schlick's Fresnel (1994) with F0 = Ks,
+// the diffuse lobe scaled by what Fresnel leaves at wo, roughness alpha = sqrt(2 / (Ns + 2)).
+namespace model {
+
+double ggxD(double cosH, double a) {
+  const double t = cosH * cosH * (a * a - 1) + 1;
+  return a * a / (M_PI * t * t);
+}
+double smithLambda(double cosW, double a) {
+  const double tan2 = (1 - cosW * cosW) / (cosW * cosW);
+  return (std::sqrt(1 + a * a * tan2) - 1) / 2;
+}
+double schlick(double f0, double cosD) { return f0 + (1 - f0) * std::pow(1 - cosD, 5); }
+double alphaFromNs(double ns) { return std::max(std::sqrt(2 / (ns + 2)), 1e-3); }
+
+// f(wo, wi) of illum 2 (diffuse Kd + GGX glossy Ks), one channel, n = +z.
+double glossyBrdf(double kd, double ks, double ns, const double wo[3], const double wi[3]) {
+  if (wo[2] <= 0 || wi[2] <= 0) return 0;
+  double h[3] = {wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]};
+  const double len = std::sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
+  for (double& c : h) c /= len;
+  const double a = alphaFromNs(ns), cosD = wo[0] * h[0] + wo[1] * h[1] + wo[2] * h[2];
+  const double g2 = 1 / (1 + smithLambda(wo[2], a) + smithLambda(wi[2], a));
+  const double specular = schlick(ks, cosD) * ggxD(h[2], a) * g2 / (4 * wo[2] * wi[2]);
+  const double diffuse = kd / M_PI * (ks > 0 ? 1 - schlick(ks, wo[2]) : 1);
+  return diffuse + specular;
+}
+
+// The directional albedo: the integral of f cos over the hemisphere, by the midpoint rule in
+// (theta, phi); wo lies in the xz-plane, so the half phi in [0, pi] is doubled.
+double glossyAlbedo(double kd, double ks, double ns, double thetaO) {
+  const int nt = 2048, np = 512;
+  const double wo[3] = {std::sin(thetaO), 0, std::cos(thetaO)};
+  double sum = 0;
+  for (int i = 0; i < nt; ++i) {
+    const double t = (i + 0.5) / nt * M_PI / 2;
+    for (int j = 0; j < np; ++j) {
+      const double p = (j + 0.5) / np * M_PI;
+      const double wi[3] = {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
+      sum += glossyBrdf(kd, ks, ns, wo, wi) * std::cos(t) * std::sin(t);
+    }
+  }
+  return 2 * sum * (M_PI / 2 / nt) * (M_PI / np);
+}
+
+// Unpolarized reflectance of a smooth dielectric, in Fresnel's sine and tangent form (a
+// different route from the kernel's); 1 beyond the critical angle. eta: transmitted over
+// incident index.
+double dielectricReflectance(double thetaI, double eta) {
+  if (thetaI == 0) return std::pow((eta - 1) / (eta + 1), 2);
+  const double sinT = std::sin(thetaI) / eta;
+  if (sinT >= 1) return 1;
+  const double thetaT = std::asin(sinT);
+  const double rs = std::pow(std::sin(thetaI - thetaT) / std::sin(thetaI + thetaT), 2);
+  const double rp = std::pow(std::tan(thetaI - thetaT) / std::tan(thetaI + thetaT), 2);
+  return (rs + rp) / 2;
+}
+
+}  // namespace model
+
+struct GlossyCase {
+  float kd, ks, ns;
+};
+const GlossyCase kGlossy[] = {{0.f, 1.f, 10.f}, {0.f, 0.04f, 10.f}, {0.f, 0.5f, 100.f},
+                              {0.5f, 0.04f, 50.f}, {0.3f, 0.9f, 1000.f}};
+
+TEST_F(BsdfOnDevice, GlossyEvaluationMatchesThePublishedFormulas) {
+  std::vector<float> dirs;
+  std::vector<std::array<double, 3>> wis;
+  for (int t = 1; t <= 30; ++t)
+    for (int p = 0; p < 24; ++p) {
+      const double theta = t * 2.95 * M_PI / 180, phi = p * 15.0 * M_PI / 180;
+      wis.push_back({std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)});
+      dirs.insert(dirs.end(), {float(wis.back()[0]), float(wis.back()[1]), float(wis.back()[2]), 0.f});
+    }
+  for (const GlossyCase& c : kGlossy)
+    for (float thetaO : {0.f, 30.f, 60.f, 80.f, 88.f}) {
+      const float3 wo = fromAngle(thetaO);
+      const double wod[3] = {wo[0], wo[1], wo[2]};
+      const std::vector<float> f = eval(material(c.kd, c.ks, c.ns, 2), wo, dirs);
+      int wrong = 0;
+      for (size_t i = 0; i < wis.size(); ++i) {
+        double wi[3] = {dirs[4 * i], dirs[4 * i + 1], dirs[4 * i + 2]};
+        const double expected = model::glossyBrdf(c.kd, c.ks, c.ns, wod, wi);
+        if (std::fabs(f[i] - expected) > 2e-3 * expected + 1e-5 && wrong++ < 3)
+          ADD_FAILURE() << "kd " << c.kd << " ks " << c.ks << " Ns " << c.ns << " theta_o " << thetaO << " wi ("
+                        << wi[0] << ", " << wi[1] << ", " << wi[2] << "): f " << f[i] << ", the formulas give "
+                        << expected;
+      }
+    }
+}
+
+TEST_F(BsdfOnDevice, GlossyAlbedoMatchesQuadratureOfTheFormulas) {
+  // The sampled estimate E[f cos / pdf] at wo against the integral of the formulas: what a
+  // glossy surface under uniform light of radiance 1 reflects toward wo.
+  const size_t n = 1 << 20;
+  for (const GlossyCase& c : kGlossy)
+    for (float thetaO : {0.f, 45.f, 80.f}) {
+      const Samples s = sample(material(c.kd, c.ks, c.ns, 2), fromAngle(thetaO), n);
+      double sum = 0, sumSq = 0;
+      for (size_t i = 0; i < n; ++i) {
+        sum += s.weight[4 * i];
+        sumSq += double(s.weight[4 * i]) * s.weight[4 * i];
+      }
+      const double mean = sum / n, stdErr = std::sqrt(std::max(sumSq / n - mean * mean, 0.0) / n);
+      const double exact = model::glossyAlbedo(c.kd, c.ks, c.ns, thetaO * M_PI / 180);
+      EXPECT_NEAR(mean, exact, 5 * stdErr + 2e-3 * exact)
+          << "kd " << c.kd << " ks " << c.ks << " Ns " << c.ns << " theta_o " << thetaO;
+    }
+}
+
+TEST_F(BsdfOnDevice, DielectricReflectsAsFresnelsEquationsSay) {
+  const size_t n = 1 << 18;
+  for (float ni : {1.33f, 1.5f, 2.4f}) {
+    const auto glass = material(0.f, 0.f, 0.f, 7, ni, 1.f);
+    for (float thetaDeg : {0.f, 30.f, 60.f, 75.f, 85.f}) {
+      const Samples s = sample(glass, fromAngle(thetaDeg), n);
+      size_t reflected = 0;
+      for (size_t i = 0; i < n; ++i) reflected += s.wiPdf[4 * i + 2] > 0.f;
+      const double r = model::dielectricReflectance(thetaDeg * M_PI / 180, ni);
+      EXPECT_NEAR(double(reflected) / n, r, 4.5 * std::sqrt(r * (1 - r) / n) + 1e-4)
+          << "entering index " << ni << " at " << thetaDeg << " degrees";
+    }
+    // From inside, below the critical angle: the relative index is 1 / Ni.
+    const float3 inside = {std::sin(0.3f), 0.f, -std::cos(0.3f)};
+    const Samples s = sample(glass, inside, n);
+    size_t reflected = 0;
+    for (size_t i = 0; i < n; ++i) reflected += s.wiPdf[4 * i + 2] < 0.f;
+    const double r = model::dielectricReflectance(0.3, 1.0 / ni);
+    EXPECT_NEAR(double(reflected) / n, r, 4.5 * std::sqrt(r * (1 - r) / n) + 1e-4) << "leaving index " << ni;
+  }
 }
 
 // ---- White furnaces ----

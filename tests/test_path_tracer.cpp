@@ -158,6 +158,29 @@ TEST_P(EveryMethod, PlaneUnderRectangularEmitterFollowsLambertsFormula) {
   expectMatches(r.film, [&](size_t p) { return double(exact.rgb[3 * p]); }, methodName(GetParam()));
 }
 
+// Vertex normals that oppose the winding are turned to the geometric normal's side: the
+// plane and the emitter, given normals pointing away from their fronts, still follow
+// Lambert's formula (not turned, the plane would reflect nothing). The emitter still emits
+// from its counter-clockwise side only.
+TEST_P(EveryMethod, VertexNormalsAgainstTheWindingShadeLikeFlatFaces) {
+  Scene scene = PlaneUnderLight::scene();
+  scene.cornerNormals.clear();
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    const Vec3f a = scene.corner(t, 0), b = scene.corner(t, 1), c = scene.corner(t, 2);
+    const Vec3f e1{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    Vec3f n{e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+    const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (int k = 0; k < 3; ++k)
+      for (int i = 0; i < 3; ++i) scene.cornerNormals.push_back(-n[size_t(i)] / len);
+  }
+  const int size = 24;
+  const Rendered r = render(scene, scene.camera, GetParam(), size, 256);
+  EXPECT_EQ(r.stats.nonfinite, 0u);
+  const Image exact = PlaneUnderLight::reference(scene.camera, size, size, 8, true);
+  expectMatches(r.film, [&](size_t p) { return double(exact.rgb[3 * p]); },
+                std::string(methodName(GetParam())) + ", normals against the winding");
+}
+
 // Adaptive sampling keeps each pixel its own mean: the same closed form holds where pixels
 // have different sample counts. The camera looks up, over the plane's far edge: most pixels
 // see nothing (no noise) and get fewer samples than the plane's few rows (the emitter's
