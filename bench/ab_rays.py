@@ -9,34 +9,28 @@ Each round runs `bench SCENES --repeats R --json` with OLD then NEW (the order s
 other round) and reports, per scene and ray kind, each binary's median Mrays/s and ratio to
 Embree over the rounds, and NEW/OLD of the Mrays/s medians. SCENES default to the bench's.
 """
-import argparse, json, os, statistics, subprocess, sys, tempfile
+import argparse, os, statistics, sys, tempfile
+
+import benchlib
 
 
 def bench(binary, scenes, repeats, path):
-    subprocess.run([binary, "bench"] + scenes + ["--repeats", str(repeats), "--json", path, "--force"],
-                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    with open(path) as f:
-        doc = json.load(f)
+    doc = benchlib.bench(scenes + ["--repeats", str(repeats)], path, binary)
     return {(r["scene"], r["ray_kind"]): (r["mrays_per_s"], r.get("ratio_to_embree")) for r in doc["records"]}
 
 
 def main():
-    argv = sys.argv[1:]
-    split = argv.index("--") if "--" in argv else len(argv)
     parser = argparse.ArgumentParser(description="ab_rays.py OLD NEW [--rounds N] [--repeats R] [-- SCENES...]")
     parser.add_argument("old")
     parser.add_argument("new")
-    parser.add_argument("--rounds", type=int, default=4)
+    benchlib.add_arguments(parser, "--rounds", rounds=4)
     parser.add_argument("--repeats", type=int, default=3)
-    opts = parser.parse_args(argv[:split])
-    scenes = argv[split + 1:]
-    runs = {"old": [], "new": []}
+    opts, scenes = benchlib.parse_with_rest(parser)
     with tempfile.TemporaryDirectory() as workdir:
-        for r in range(opts.rounds):
-            order = ("old", "new") if r % 2 == 0 else ("new", "old")
-            for tag in order:
-                runs[tag].append(bench(getattr(opts, tag), scenes, opts.repeats, os.path.join(workdir, tag + ".json")))
-            print(f"round {r + 1} done", file=sys.stderr)
+        runners = {tag: lambda r, tag=tag: bench(getattr(opts, tag), scenes, opts.repeats,
+                                                 os.path.join(workdir, tag + ".json")) for tag in ("old", "new")}
+        runs = benchlib.alternate(runners, opts.rounds, warmup=False,
+                                  after_round=lambda r, _: print(f"round {r + 1} done", file=sys.stderr))
     keys = sorted(set(runs["old"][0]) & set(runs["new"][0]))
     print(f"{'scene':<12} {'kind':<8} {'old Mrays/s':>12} {'new Mrays/s':>12} {'new/old':>8} "
           f"{'old ratio':>10} {'new ratio':>10}")
@@ -48,8 +42,8 @@ def main():
             med[tag] = (statistics.median(speeds), statistics.median(ratios) if ratios else float("nan"), speeds)
         print(f"{key[0]:<12} {key[1]:<8} {med['old'][0]:>12.2f} {med['new'][0]:>12.2f} "
               f"{med['new'][0] / med['old'][0]:>8.2f} {med['old'][1]:>10.2f} {med['new'][1]:>10.2f}"
-              f"   (old {', '.join(f'{s:.1f}' for s in med['old'][2])}; new {', '.join(f'{s:.1f}' for s in med['new'][2])})")
+              f"   (old {benchlib.runs(med['old'][2], '%.1f')}; new {benchlib.runs(med['new'][2], '%.1f')})")
 
 
 if __name__ == "__main__":
-    main()
+    benchlib.main(main)

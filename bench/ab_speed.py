@@ -13,60 +13,46 @@ samples/s from --stats and times the whole process (start-up, scene, BVH and ker
 included, which --stats may leave out), and reports each binary's medians and NEW/OLD.
 The first render of each binary is a warm-up (kernel compilation) and is not counted.
 """
-import argparse, json, os, statistics, subprocess, sys, tempfile, time
+import argparse, os, statistics, sys, tempfile
+
+import benchlib
 
 
 def render(binary, args, workdir, tag, extra=()):
-    out, stats = os.path.join(workdir, tag + ".pfm"), os.path.join(workdir, tag + ".json")
-    for path in (out, stats):
-        if os.path.exists(path):
-            os.remove(path)
-    start = time.monotonic()
-    subprocess.run([binary] + args + list(extra) + ["-o", out, "--stats", stats], check=True,
-                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    wall = time.monotonic() - start
-    with open(stats) as f:
-        doc = json.load(f)
-    return doc["samples_per_second"], doc["samples"] / wall
+    """(samples/s from --stats, samples per second of the whole process)."""
+    stats = benchlib.render(args[1:] + list(extra), os.path.join(workdir, tag + ".pfm"), binary)
+    return stats["samples_per_second"], stats["samples"] / stats.wall_seconds
 
 
 def main():
-    argv = sys.argv[1:]
-    if "--" not in argv:
-        sys.exit("usage: ab_speed.py OLD NEW [--rounds N] -- render ARGS...")
-    split = argv.index("--")
     parser = argparse.ArgumentParser()
     parser.add_argument("old")
     parser.add_argument("new")
-    parser.add_argument("--rounds", type=int, default=5)
+    benchlib.add_arguments(parser, "--rounds", rounds=5)
     parser.add_argument("--old-args", default="")
     parser.add_argument("--new-args", default="")
-    opts = parser.parse_args(argv[:split])
+    opts, args = benchlib.parse_with_rest(parser)
+    if "--" not in sys.argv[1:] or args[:1] != ["render"]:
+        sys.exit("usage: ab_speed.py OLD NEW [--rounds N] -- render ARGS...")
     extras = {"old": opts.old_args.split(), "new": opts.new_args.split()}
-    args = argv[split + 1:]
-    speeds = {"old": [], "new": []}  # (stats samples/s, samples per process second)
     binaries = {"old": opts.old, "new": opts.new}
-    with tempfile.TemporaryDirectory() as workdir:
-        for tag in ("old", "new"):
-            render(binaries[tag], args, workdir, tag, extras[tag])  # warm-up
-        for r in range(opts.rounds):
-            for tag in (("old", "new") if r % 2 == 0 else ("new", "old")):
-                speeds[tag].append(render(binaries[tag], args, workdir, tag, extras[tag]))
+    with tempfile.TemporaryDirectory() as workdir:  # each result: (stats samples/s, samples per process second)
+        speeds = benchlib.alternate({tag: lambda r, tag=tag: render(binaries[tag], args, workdir, tag, extras[tag])
+                                     for tag in ("old", "new")}, opts.rounds)
     print("fredholm " + " ".join(args) + "".join(f"  [{t}: {' '.join(e)}]" for t, e in extras.items() if e))
     medians = {}
     for tag in ("old", "new"):
         rate = [s for s, _ in speeds[tag]]
         whole = [w for _, w in speeds[tag]]
         medians[tag] = (statistics.median(rate), statistics.median(whole))
-        runs = ", ".join("%.3f" % (s / 1e6) for s in rate)
         print("  %-3s median %.3f Msamples/s rendering, %.3f per process second  (runs: %s)"
-              % (tag, medians[tag][0] / 1e6, medians[tag][1] / 1e6, runs))
+              % (tag, medians[tag][0] / 1e6, medians[tag][1] / 1e6, benchlib.runs([s / 1e6 for s in rate])))
     print("  new/old %.3f rendering, %.3f per process second"
           % (medians["new"][0] / medians["old"][0], medians["new"][1] / medians["old"][1]))
     # The machine drifts within a run too: the two renders of one round ran close together.
-    per_round = [n[0] / o[0] for o, n in zip(speeds["old"], speeds["new"])]
-    print("  new/old per round: median %.3f  (%s)" % (statistics.median(per_round),
-                                                      ", ".join("%.2f" % r for r in per_round)))
+    per_round = benchlib.ratios([n for n, _ in speeds["new"]], [o for o, _ in speeds["old"]])
+    print("  new/old per round: median %.3f  (%s)" % (statistics.median(per_round), benchlib.runs(per_round, "%.2f")))
+
 
 if __name__ == "__main__":
-    main()
+    benchlib.main(main)

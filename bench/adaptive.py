@@ -14,10 +14,8 @@ off each measurement. Needs Debian's python3-matplotlib.
 """
 import argparse
 import csv
-import json
 import math
 import os
-import subprocess
 import sys
 
 import matplotlib
@@ -25,30 +23,11 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-FREDHOLM = os.path.join(ROOT, "build", "fredholm")
+import benchlib  # noqa: E402  (beside this script)
 
 
 def render(a, out, flags):
-    cmd = [FREDHOLM, "render"] + ([a.scene] if a.scene else []) + [
-        "--width", str(a.width), "--height", str(a.height), "-o", out, "--stats", out + ".json", "--force"] + flags
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    with open(out + ".json") as f:
-        return json.load(f)
-
-
-def estimated_relmse(image):
-    """The render's own error estimate, from the image's metadata (fredholm:estimated_relmse)."""
-    meta = subprocess.run(["oiiotool", "--info", "-v", image], check=True, capture_output=True, text=True).stdout
-    for line in meta.splitlines():
-        if "estimated_relmse" in line:
-            return float(line.split(":")[-1].strip().strip('"'))
-    raise RuntimeError(image + " has no estimated_relmse")
-
-
-def relmse(image, reference):
-    out = subprocess.run([FREDHOLM, "compare", image, reference], check=True, capture_output=True, text=True)
-    return json.loads(out.stdout)["relmse"]
+    return benchlib.render(benchlib.image_flags(a) + flags, out, a.binary)
 
 
 def seconds_to(target, points):
@@ -62,21 +41,14 @@ def seconds_to(target, points):
 
 
 def main():
-    argv = sys.argv[1:]
-    extra = argv[argv.index("--") + 1:] if "--" in argv else []
-    argv = argv[:argv.index("--")] if "--" in argv else argv
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("scene", nargs="?", default="", help="OBJ file (default: the built-in Cornell box)")
+    benchlib.add_arguments(p, "scene", "--binary", "--width", "--height", "--ref", "--ref-spp")
     p.add_argument("--name", required=True)
-    p.add_argument("--width", type=int, default=128)
-    p.add_argument("--height", type=int, default=128)
-    p.add_argument("--ref")
-    p.add_argument("--ref-spp", type=int, default=4096)
     p.add_argument("--spps", default="16,32,64,128,256")
     p.add_argument("--target", type=float, default=1e-2)
-    p.add_argument("--seeds", default="1", help="seeds per budget (their relMSE and seconds are averaged)")
-    p.add_argument("--out", default="bench/out/adaptive")
-    a = p.parse_args(argv)
+    benchlib.add_arguments(p, "--seeds", "--out", out=benchlib.scratch_path("adaptive"),
+                           seeds=dict(default="1", help="seeds per budget (their relMSE and seconds are averaged)"))
+    a, extra = benchlib.parse_with_rest(p)
     os.makedirs(a.out, exist_ok=True)
     ref = a.ref
     if not ref:  # with two replicates (a target it never meets), for its own error estimate
@@ -84,7 +56,7 @@ def main():
         if not os.path.exists(ref):
             render(a, ref, ["--spp", str(a.ref_spp), "--seed", "1000", "--noise", "1e-12"] + extra)
     # The reference's own error adds to every image's relMSE against it (they are independent).
-    ref_error = estimated_relmse(ref)
+    ref_error = float(benchlib.image_metadata(ref)["estimated_relmse"])
     print(f"reference {ref}: its estimated relMSE {ref_error:.2e} is taken off", file=sys.stderr)
     for mode in ([], ["--adaptive"]):  # PoCL compiles kernels at their first launch: not timed
         render(a, os.path.join(a.out, a.name + "-warm.exr"), ["--spp", "16"] + mode + extra)
@@ -96,7 +68,7 @@ def main():
                 img = os.path.join(a.out, f"{a.name}-{mode}-{spp}.exr")
                 flags = ["--spp", str(spp), "--seed", seed] + (["--adaptive"] if mode == "adaptive" else []) + extra
                 stats = render(a, img, flags)
-                errors.append(relmse(img, ref) - ref_error)
+                errors.append(benchlib.compare(img, ref, a.binary)["relmse"] - ref_error)
                 times.append(stats["seconds"])
             e, t = sum(errors) / len(errors), sum(times) / len(times)
             rows.append({"mode": mode, "spp": spp, "seconds": t, "relmse": e})
@@ -126,4 +98,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    benchlib.main(main)

@@ -18,26 +18,23 @@ Needs Debian's python3-numpy and python3-openimageio (apt-get install python3-op
 """
 import argparse
 import os
-import subprocess
 import tempfile
 
 import numpy as np
-import OpenImageIO as oiio
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-FREDHOLM = os.path.join(ROOT, "build", "fredholm")
+import benchlib
+
 EPSILON = 1e-2  # relMSE's (host/image/error_metrics.h)
 
 
 def render(a, out, flags):
-    w, h = a.size.split("x")
-    cmd = [FREDHOLM, "render"] + ([a.scene] if a.scene else []) + ["--width", w, "--height", h, "-o", out,
-                                                                    "--force"] + flags
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    benchlib.render(benchlib.image_flags(a) + flags, out, a.binary, stats=False)
 
 
 def layer(exr, channels):
     """Channels of an EXR (e.g. "R,G,B" or "spp.Y") as an h x w x n array."""
+    import OpenImageIO as oiio  # here, so that --help works without it
+
     image = oiio.ImageBuf(exr)
     names = list(image.spec().channelnames)
     pixels = image.get_pixels(oiio.FLOAT)
@@ -91,12 +88,8 @@ def bound(a, tmp):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("scene", nargs="?", default="", help="OBJ (default: the built-in Cornell box)")
-    p.add_argument("--size", default="128x128")
-    p.add_argument("--spp", type=int, default=512)
-    p.add_argument("--ref-spp", type=int, default=8192)
-    p.add_argument("--ref", help="a reference EXR already rendered (uniform, same size)")
-    p.add_argument("--seeds", default="1,2")
+    benchlib.add_arguments(p, "scene", "--binary", "--size", "--spp", "--ref-spp", "--ref", "--seeds", spp=512,
+                           ref_spp=8192)
     p.add_argument("--bound-spps", default="16,32,64,128,256,512")
     a = p.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
@@ -109,4 +102,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    benchlib.main(main)

@@ -15,44 +15,30 @@ about relMSE(max-spp run) * max-spp / ref-spp. Needs Debian's python3-matplotlib
 """
 import argparse
 import csv
-import json
 import os
 import re
-import subprocess
-import sys
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from converge_table import equal_time  # noqa: E402  (beside this script)
-
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-FREDHOLM = os.path.join(ROOT, "build", "fredholm")
+import benchlib  # noqa: E402  (beside this script)
+from converge_table import equal_time  # noqa: E402
 
 
-def render(scene, out, spp, method, seed, args, extra):
+def render(out, spp, method, seed, args, extra):
     """Renders; returns the --stats JSON, and for mis+denoise the denoised image's path and the
     render's seconds with the denoiser's added."""
     denoise = method == "mis+denoise"
-    cmd = [FREDHOLM, "render"] + ([scene] if scene else []) + [
-        "--width", str(args.width), "--height", str(args.height), "--spp", str(spp),
-        "--method", "mis" if denoise else method, "--seed", str(seed), "-o", out, "--stats", out + ".json",
-        "--force"] + (["--denoise"] if denoise else []) + extra
-    run = subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    with open(out + ".json") as f:
-        stats = json.load(f)
+    flags = benchlib.image_flags(args) + ["--spp", str(spp), "--method", "mis" if denoise else method,
+                                          "--seed", str(seed)] + (["--denoise"] if denoise else []) + extra
+    stats = benchlib.render(flags, out, args.binary)
     if denoise:
-        took = re.search(r"fredholm: denoised in ([0-9.]+) s", run.stderr)
+        took = re.search(r"fredholm: denoised in ([0-9.]+) s", stats.stderr)
         stats["seconds"] += float(took.group(1))
         stats["image"] = out[:-len(".exr")] + ".denoised.exr"
     return stats
-
-
-def compare(image, reference):
-    out = subprocess.run([FREDHOLM, "compare", image, reference], check=True, capture_output=True, text=True)
-    return json.loads(out.stdout)
 
 
 def crossover(rows, a, b):
@@ -88,23 +74,14 @@ def crossover(rows, a, b):
 
 
 def main():
-    argv = sys.argv[1:]
-    extra = []
-    if "--" in argv:
-        extra = argv[argv.index("--") + 1:]
-        argv = argv[:argv.index("--")]
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("scene", nargs="?", default="", help="OBJ file (default: the built-in Cornell box)")
-    p.add_argument("--out", default="bench/out/converge")
-    p.add_argument("--width", type=int, default=128)
-    p.add_argument("--height", type=int, default=128)
+    benchlib.add_arguments(p, "scene", "--binary", "--out", "--width", "--height",
+                           out=benchlib.scratch_path("converge"))
     p.add_argument("--max-spp", type=int, default=256)
-    p.add_argument("--ref")
-    p.add_argument("--ref-spp", type=int, default=4096)
-    p.add_argument("--methods", default="pt,nee,mis")
+    benchlib.add_arguments(p, "--ref", "--ref-spp", "--methods")
     p.add_argument("--name", help="the CSV's and chart's name (default: the scene's)")
     p.add_argument("--from-csv", help="chart an earlier run's CSV again, rendering nothing")
-    args = p.parse_args(argv)
+    args, extra = benchlib.parse_with_rest(p)
     os.makedirs(args.out, exist_ok=True)
     scene_name = os.path.splitext(os.path.basename(args.scene))[0].replace(":", "-") if args.scene else "cornell-box"
     name = args.name or scene_name
@@ -120,19 +97,19 @@ def main():
         if os.path.exists(reference):  # the same scene, size and spp: made by an earlier chart
             print(f"reference: {reference} (kept)")
         else:
-            stats = render(args.scene, reference, args.ref_spp, "mis", 1000, args, extra)
+            stats = render(reference, args.ref_spp, "mis", 1000, args, extra)
             print(f"reference: mis, {args.ref_spp} spp, {stats['seconds']:.1f} s -> {reference}")
 
     rows = []
     for method in args.methods.split(","):
         # A throw-away render first: PoCL compiles each kernel at its first launch, which
         # would otherwise count in the first point's time.
-        render(args.scene, os.path.join(args.out, f"{name}-{method}-warmup.exr"), 1, method, 999, args, extra)
+        render(os.path.join(args.out, f"{name}-{method}-warmup.exr"), 1, method, 999, args, extra)
         spp = 1
         while spp <= args.max_spp:
             image = os.path.join(args.out, f"{name}-{method}-{spp}.exr")
-            stats = render(args.scene, image, spp, method, spp, args, extra)
-            err = compare(stats.get("image", image), reference)
+            stats = render(image, spp, method, spp, args, extra)
+            err = benchlib.compare(stats.get("image", image), reference, args.binary)
             rows.append({"scene": name, "method": method, "spp": spp, "seconds": stats["seconds"],
                          "relMSE": err["relmse"], "RMSE": err["rmse"], "MAE": err["mae"]})
             print(f"{method:4s} {spp:6d} spp {stats['seconds']:8.2f} s  relMSE {err['relmse']:.3e}")
@@ -182,4 +159,4 @@ def chart(rows, name, args):
 
 
 if __name__ == "__main__":
-    main()
+    benchlib.main(main)

@@ -7,19 +7,22 @@ For each scene, every method's relMSE is read off its error-against-time curve (
 interpolation) at the longest time every method reached, and printed as a Markdown table
 with each entry's ratio to the best method of its row (1.0 = best).
 """
+import argparse
 import csv
 import glob
 import math
 import os
-import sys
+
+import benchlib
 
 METHODS = ("pt", "nee", "mis")
 
 
 def read_rows(path):
+    """converge.py's rows; none from another CSV (adaptive.py's lie beside them)."""
     with open(path) as f:
         return [dict(r, spp=int(r["spp"]), seconds=float(r["seconds"]), relMSE=float(r["relMSE"]))
-                for r in csv.DictReader(f)]
+                for r in csv.DictReader(f) if "method" in r and "relMSE" in r]
 
 
 def relmse_at(points, target):
@@ -44,12 +47,15 @@ def equal_time(rows):
 
 
 def main():
-    folder = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(os.path.abspath(__file__)), "results",
-                                                                "convergence")
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("folder", nargs="?", default=benchlib.results_path("convergence"), help="where the CSVs are")
+    folder = p.parse_args().folder
     print("| scene | time | " + " | ".join(f"`{m}` relMSE (× best)" for m in METHODS) + " |")
     print("|---|---|" + "---|" * len(METHODS))
     for path in sorted(glob.glob(os.path.join(folder, "*.csv"))):
         rows = read_rows(path)
+        if not rows:
+            continue
         target, values = equal_time(rows)
         best = min(v for v in values.values() if not math.isnan(v))
         cells = []

@@ -22,19 +22,17 @@ import json
 import os
 import re
 import shutil
-import subprocess
 import sys
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-FREDHOLM = os.path.join(ROOT, "build", "fredholm")
-CYCLES_SCRIPT = os.path.join(ROOT, "bench", "cycles_reference.py")
+import benchlib
+
+CYCLES_SCRIPT = os.path.join(benchlib.ROOT, "bench", "cycles_reference.py")
 
 
 def run(cmd):
-    result = subprocess.run(cmd, capture_output=True, text=True)
-    if result.returncode != 0:
-        sys.exit(f"cycles_compare: {' '.join(cmd[:3])} ... failed:\n{result.stdout[-2000:]}{result.stderr[-2000:]}")
-    return result.stdout + result.stderr
+    """Runs cmd; returns its stdout and stderr (Blender's progress lines)."""
+    done = benchlib.run(cmd, stdout=True)
+    return done.stdout + done.stderr
 
 
 def cycles(obj, output, args, spp, seed):
@@ -48,16 +46,9 @@ def cycles(obj, output, args, spp, seed):
 
 
 def fredholm(obj, output, args, spp, seed):
-    stats = output + ".json"
-    run([FREDHOLM, "render", obj, "--width", str(args.width), "--height", str(args.height), "--spp", str(spp),
-         "--method", "mis", "--filter", "box", "--max-depth", "64", "--seed", str(seed), "-o", output,
-         "--stats", stats, "--force"])
-    with open(stats) as f:
-        return json.load(f)["seconds"]
-
-
-def compare(image, reference, block=1):
-    return json.loads(run([FREDHOLM, "compare", "--block", str(block), image, reference]))
+    return benchlib.render([obj, "--width", str(args.width), "--height", str(args.height), "--spp", str(spp),
+                            "--method", "mis", "--filter", "box", "--max-depth", "64", "--seed", str(seed)], output,
+                           args.binary)["seconds"]
 
 
 def mean_ratio(a, b):
@@ -68,11 +59,11 @@ def check_units(args, out):
     obj = os.path.join(out, "plane-under-light.obj")
     exact = os.path.join(out, "plane-under-light-exact.exr")
     image = os.path.join(out, "plane-under-light-cycles.exr")
-    run([FREDHOLM, "export", "builtin:plane-under-light", "-o", obj, "--force"])
-    run([FREDHOLM, "reference", "builtin:plane-under-light", "--width", str(args.width), "--height",
+    run([args.binary, "export", "builtin:plane-under-light", "-o", obj, "--force"])
+    run([args.binary, "reference", "builtin:plane-under-light", "--width", str(args.width), "--height",
          str(args.height), "-o", exact, "--force"])
     seconds = cycles(obj, image, args, args.plane_spp, 1)
-    e = compare(image, exact)
+    e = benchlib.compare(image, exact, args.binary, 1)
     factor = mean_ratio(e["mean_image"], e["mean_reference"])[0]
     print(f"plane under a light: Cycles / exact mean = {factor:.4f}, relMSE {e['relmse']:.2e} "
           f"({args.plane_spp} spp, {seconds:.1f} s)")
@@ -82,7 +73,7 @@ def check_units(args, out):
 
 def compare_cornell(args, out):
     obj = os.path.join(out, "cornell-box.obj")
-    run([FREDHOLM, "export", "-o", obj, "--force"])
+    run([args.binary, "export", "-o", obj, "--force"])
     images, seconds = {}, {}
     for seed in (1, 2):
         for name, renderer in (("fredholm", fredholm), ("cycles", cycles)):
@@ -92,10 +83,12 @@ def compare_cornell(args, out):
             print(f"  {key}: {args.spp} spp in {seconds[key]:.1f} s")
     result = {"spp": args.spp, "width": args.width, "height": args.height, "seconds": seconds}
     for block in (1, args.block):
-        across = [compare(images["fredholm1"], images["cycles1"], block),
-                  compare(images["fredholm2"], images["cycles2"], block)]
-        fh_noise = compare(images["fredholm1"], images["fredholm2"], block)["relmse"]
-        cy_noise = compare(images["cycles1"], images["cycles2"], block)["relmse"]
+        def compare(image, reference):
+            return benchlib.compare(images[image], images[reference], args.binary, block)
+
+        across = [compare("fredholm1", "cycles1"), compare("fredholm2", "cycles2")]
+        fh_noise = compare("fredholm1", "fredholm2")["relmse"]
+        cy_noise = compare("cycles1", "cycles2")["relmse"]
         measured = sum(e["relmse"] for e in across) / 2
         expected = fh_noise / 2 + cy_noise / 2
         result[f"block{block}"] = {"relmse_fredholm_vs_cycles": measured, "relmse_expected_from_noise": expected,
@@ -124,17 +117,15 @@ def side_by_side(a, b, png):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--out", default=os.path.join(ROOT, "bench", "out", "cycles"))
-    p.add_argument("--width", type=int, default=128)
-    p.add_argument("--height", type=int, default=128)
-    p.add_argument("--spp", type=int, default=4096)
+    benchlib.add_arguments(p, "--binary", "--out", "--width", "--height", "--spp", out=benchlib.scratch_path("cycles"),
+                           spp=4096)
     p.add_argument("--plane-spp", type=int, default=1024)
     p.add_argument("--block", type=int, default=8)
     args = p.parse_args()
     if not shutil.which("blender"):
         sys.exit("cycles_compare: blender not found (apt-get install blender)")
-    if not os.access(FREDHOLM, os.X_OK):
-        sys.exit(f"cycles_compare: {FREDHOLM} not built (./setup.sh build)")
+    if not os.access(args.binary, os.X_OK):
+        sys.exit(f"cycles_compare: {args.binary} not built (./setup.sh build)")
     os.makedirs(args.out, exist_ok=True)
     print(run(["blender", "--version"]).splitlines()[0])
     result = {"blender": run(["blender", "--version"]).splitlines()[0], "units": check_units(args, args.out)}
@@ -147,4 +138,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    benchlib.main(main)

@@ -23,8 +23,9 @@ import sys
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BLOB = os.path.join(ROOT, "build", "test-scenes", "blob", "blob.obj")
+import benchlib
+
+BLOB = os.path.join(benchlib.ROOT, "build", "test-scenes", "blob", "blob.obj")
 
 SUN_ELEVATION_DEG, SUN_AZIMUTH_DEG, SUN_RADIUS_DEG = 40.0, 60.0, 1.0
 
@@ -58,7 +59,7 @@ def write_exr(path, rgb):
     with open(pfm, "wb") as f:
         f.write(b"PF\n%d %d\n-1.0\n" % (rgb.shape[1], rgb.shape[0]))
         f.write(np.ascontiguousarray(rgb[::-1]).astype("<f4").tobytes())
-    subprocess.run(["oiiotool", pfm, "-d", "float", "-o", path], check=True)
+    benchlib.run(["oiiotool", pfm, "-d", "float", "-o", path])
     os.remove(pfm)
 
 
@@ -84,11 +85,10 @@ def write_scene(folder):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--out", default=os.path.join(ROOT, "bench", "out", "env-sun"))
-    p.add_argument("--width", type=int, default=192)
-    p.add_argument("--height", type=int, default=144)
+    benchlib.add_arguments(p, "--out", "--width", "--height", out=benchlib.scratch_path("env-sun"), width=192,
+                           height=144)
     p.add_argument("--max-spp", type=int, default=256)
-    p.add_argument("--ref-spp", type=int, default=4096)
+    benchlib.add_arguments(p, "--ref-spp")
     args = p.parse_args()
     if not os.path.exists(BLOB):
         sys.exit(f"{BLOB} is missing: build first (cmake --build build)")
@@ -99,12 +99,12 @@ def main():
     write_exr(env, sky)
     print(f"wrote {env}: the sun covers {sun_texels} of {sky.shape[0] * sky.shape[1]} texels")
     scene = write_scene(folder)
-    subprocess.run([sys.executable, os.path.join(ROOT, "bench", "converge.py"), scene, "--out", args.out,
+    subprocess.run([sys.executable, os.path.join(benchlib.ROOT, "bench", "converge.py"), scene, "--out", args.out,
                     "--width", str(args.width), "--height", str(args.height), "--max-spp", str(args.max_spp),
                     "--ref-spp", str(args.ref_spp), "--", "--env-map", env], check=True)
     for ext in (".csv", ".png"):
-        shutil.copy(os.path.join(args.out, "sun-blob" + ext), os.path.join(ROOT, "bench", "results", "convergence"))
+        shutil.copy(os.path.join(args.out, "sun-blob" + ext), benchlib.results_path("convergence"))
 
 
 if __name__ == "__main__":
-    main()
+    benchlib.main(main)

@@ -16,7 +16,9 @@ function, per call chain, per source line and per innermost loop of the machine 
 the lines most sampled in it). Needs perf (Debian linux-perf), llvm-symbolizer (llvm) and
 objdump (binutils).
 """
-import argparse, bisect, collections, difflib, glob, os, re, subprocess, sys, tempfile
+import argparse, bisect, collections, difflib, os, re, subprocess, sys, tempfile
+
+import benchlib
 
 
 def functions(disassembly):
@@ -39,15 +41,11 @@ def shape(instruction):
 
 
 def main():
-    argv = sys.argv[1:]
-    split = argv.index("--") if "--" in argv else len(argv)
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--fredholm", default=os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
-                                                       "build", "fredholm"))
+    benchlib.add_arguments(ap, "--binary")
     ap.add_argument("--kernel", default="megakernel")
     ap.add_argument("--top", type=int, default=30)
-    args = ap.parse_args(argv[:split])
-    command = argv[split + 1:]
+    args, command = benchlib.parse_with_rest(ap)
     if not command:
         ap.error("give the fredholm command after --, e.g. -- render scene.obj --spp 64")
     # The scratch folder (perf's record, the caches, the image) goes when the report is out.
@@ -61,12 +59,11 @@ def profile(args, command, work):
     cache, data = os.path.join(work, "cache"), os.path.join(work, "perf.data")
     # Both caches fresh: a program loaded from fredholm's binary cache is compiled by PoCL
     # without the line table that -g gives a build from source.
-    env = dict(os.environ, FREDHOLM_CL_OPTIONS=(os.environ.get("FREDHOLM_CL_OPTIONS", "") + " -g").strip(),
+    env = dict(FREDHOLM_CL_OPTIONS=(os.environ.get("FREDHOLM_CL_OPTIONS", "") + " -g").strip(),
                POCL_CACHE_DIR=cache, FREDHOLM_CACHE_DIR=os.path.join(work, "programs"))
     # A render's image goes to the scratch folder; other commands (bench) write none.
     image = ["-o", os.path.join(work, "image.pfm"), "--force"] if command[0] == "render" else []
-    subprocess.run(["perf", "record", "-q", "-o", data, "--", args.fredholm] + command + image, env=env, check=True,
-                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    benchlib.run(["perf", "record", "-q", "-o", data, "--", args.binary] + command + image, env=env)
 
     kernel, workgroup = "_pocl_kernel_" + args.kernel, "_pocl_kernel_" + args.kernel + "_workgroup"
     samples = subprocess.run(["perf", "script", "-i", data, "-F", "ip,sym,symoff,dso"], capture_output=True,
@@ -165,4 +162,4 @@ def print_loops(target, hits, library, matched, to_source, line_of, top):
 
 
 if __name__ == "__main__":
-    main()
+    benchlib.main(main)

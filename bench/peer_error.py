@@ -23,78 +23,67 @@ PoCL's kernel cache), Mitsuba's `seconds_render` (after its JIT
 warm-up). Writes OUT/cornell-peers.csv and OUT/cornell-peers.png (log-log, with a slope -1
 guide: an unbiased estimator's relMSE falls as 1/time).
 """
-import argparse, csv, json, os, statistics, subprocess, sys, tempfile
+import argparse, csv, os, statistics, tempfile
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-PEER = os.path.join(ROOT, "..", "shared", "peers", "mitsuba")
-CAMERA = ["--eye", "0,1,3.5", "--target", "0,1,0", "--fov", "40", "--max-depth", "16"]
+import benchlib  # noqa: E402  (beside this script)
 
 
-def relmse(python, ref, image):
-    out = subprocess.run([python, os.path.join(PEER, "compare.py"), ref, image], check=True, capture_output=True,
-                         text=True).stdout
-    return json.loads(out.strip().splitlines()[-1])["relMSE"]
+def relmse(opts, image):
+    """relMSE of image against opts.ref by Mitsuba's compare.py."""
+    return benchlib.mitsuba(opts.mitsuba_python, "compare.py", [opts.ref, image], opts.mitsuba_dir)["relMSE"]
 
 
-def fredholm(method, spp, extra, workdir, seconds=None, seed=None):
+def fredholm(opts, method, spp, extra, workdir, seconds=None, seed=None):
     """Renders spp samples per pixel, or as many as fit in `seconds`; returns the image, the
     seconds taken and the samples per pixel rendered."""
-    image, stats = os.path.join(workdir, "f.exr"), os.path.join(workdir, "f.json")
+    image = os.path.join(workdir, "f.exr")
     budget = ["--time", str(seconds)] if seconds else []
-    subprocess.run([os.path.join(ROOT, "build", "fredholm"), "render", "--width", "512", "--height", "512",
-                    "--spp", str(spp), "--method", method, "--seed", str(seed or spp)] + budget + CAMERA + extra +
-                   ["-o", image, "--force", "--stats", stats], check=True, stdout=subprocess.DEVNULL,
-                   stderr=subprocess.DEVNULL)
-    with open(stats) as f:
-        doc = json.load(f)
-    return image, doc["seconds"], doc["samples"] // (512 * 512)
+    stats = benchlib.render(["--spp", str(spp), "--method", method, "--seed", str(seed or spp)] + budget +
+                            benchlib.PEER_VIEW + extra, image, opts.binary, stats=os.path.join(workdir, "f.json"))
+    return image, stats["seconds"], stats["samples"] // benchlib.PEER_PIXELS
 
 
-def mitsuba(python, sampler, spp, workdir, seed=None):
+def mitsuba(opts, sampler, spp, workdir, seed=None):
     image = os.path.join(workdir, "m.exr")
-    out = subprocess.run([python, os.path.join(PEER, "cbox.py"), "--variant", "llvm_ad_rgb", "--sampler", sampler,
-                          "--spp", str(spp), "--seed", str(seed or spp), "--max-bounces", "16", "--out", image],
-                         check=True, capture_output=True, text=True).stdout
-    return image, json.loads([l for l in out.splitlines() if l.startswith("{")][-1])["seconds_render"]
+    doc = benchlib.mitsuba(opts.mitsuba_python, "cbox.py", ["--variant", "llvm_ad_rgb", "--sampler", sampler,
+                                                            "--spp", str(spp), "--seed", str(seed or spp),
+                                                            "--max-bounces", "16", "--out", image], opts.mitsuba_dir)
+    return image, doc["seconds_render"]
 
 
 def main():
-    argv = sys.argv[1:]
-    extra = argv[argv.index("--") + 1:] if "--" in argv else []
-    argv = argv[:argv.index("--")] if "--" in argv else argv
     ap = argparse.ArgumentParser()
-    ap.add_argument("--ref", required=True)
+    benchlib.add_arguments(ap, "--ref", ref=dict(required=True))
     ap.add_argument("--spp", default="4,16,64,256")
-    ap.add_argument("--methods", default="mis,nee,pt")
-    ap.add_argument("--mitsuba-python", default="/opt/mi-venv/bin/python")
-    ap.add_argument("--out", default=os.path.join(ROOT, "bench", "results", "peers"))
+    benchlib.add_arguments(ap, "--methods", "--mitsuba-python", "--mitsuba-dir", "--out", "--binary",
+                           methods="mis,nee,pt", out=benchlib.results_path("peers"))
     ap.add_argument("--equal-time-rounds", type=int, default=0)
-    opts = ap.parse_args(argv)
+    opts, extra = benchlib.parse_with_rest(ap)
     os.makedirs(opts.out, exist_ok=True)
     if opts.equal_time_rounds:
         return equal_time_rounds(opts, extra)
     rows, equal_time = [], []
     with tempfile.TemporaryDirectory() as workdir:
         for method in opts.methods.split(","):
-            fredholm(method, 1, extra, workdir)  # PoCL compiles a kernel at its first launch: keep that out
+            fredholm(opts, method, 1, extra, workdir)  # PoCL compiles a kernel at its first launch: keep that out
         for spp in [int(s) for s in opts.spp.split(",")]:
             for method in opts.methods.split(","):
-                image, seconds, _ = fredholm(method, spp, extra, workdir)
-                rows.append(("fredholm " + method, spp, seconds, relmse(opts.mitsuba_python, opts.ref, image)))
+                image, seconds, _ = fredholm(opts, method, spp, extra, workdir)
+                rows.append(("fredholm " + method, spp, seconds, relmse(opts, image)))
                 print(*rows[-1], flush=True)
             for sampler in ("ldsampler", "independent"):
-                image, seconds = mitsuba(opts.mitsuba_python, sampler, spp, workdir)
-                rows.append(("mitsuba " + sampler, spp, seconds, relmse(opts.mitsuba_python, opts.ref, image)))
+                image, seconds = mitsuba(opts, sampler, spp, workdir)
+                rows.append(("mitsuba " + sampler, spp, seconds, relmse(opts, image)))
                 print(*rows[-1], flush=True)
         budget = [r for r in rows if r[0] == "mitsuba ldsampler"][-1]
         for method in opts.methods.split(","):
-            image, seconds, spp = fredholm(method, 4096, extra, workdir, seconds=budget[2])
-            equal_time.append(("fredholm " + method, spp, seconds, relmse(opts.mitsuba_python, opts.ref, image)))
+            image, seconds, spp = fredholm(opts, method, 4096, extra, workdir, seconds=budget[2])
+            equal_time.append(("fredholm " + method, spp, seconds, relmse(opts, image)))
             print("equal time:", *equal_time[-1], "against mitsuba ldsampler", *budget[1:], flush=True)
     with open(os.path.join(opts.out, "cornell-peers.csv"), "w", newline="") as f:
         w = csv.writer(f)
@@ -124,37 +113,28 @@ def equal_time_rounds(opts, extra):
     rows = []
     with tempfile.TemporaryDirectory() as workdir:
         for method in methods:
-            fredholm(method, 1, extra, workdir)  # kernel compilation, kept out of the rounds
-        mitsuba(opts.mitsuba_python, "ldsampler", spp, workdir)  # the same for Mitsuba's JIT cache
-        budget = None
-        for k in range(1, opts.equal_time_rounds + 1):
-            seed = 1000 * k + spp
+            fredholm(opts, method, 1, extra, workdir)  # kernel compilation, kept out of the rounds
+        mitsuba(opts, "ldsampler", spp, workdir)  # the same for Mitsuba's JIT cache
+        state = {"budget": None}  # the seconds Mitsuba took in the latest round
 
-            def peer():
-                image, seconds = mitsuba(opts.mitsuba_python, "ldsampler", spp, workdir, seed)
-                return ("mitsuba ldsampler", k, spp, seconds, relmse(opts.mitsuba_python, opts.ref, image))
+        def report(row):  # (renderer, round, spp, seconds, relMSE)
+            rows.append(row)
+            print("round", row[1], row[0], "spp", row[2], "seconds %.2f" % row[3], "relMSE %.4g" % row[4], flush=True)
 
-            def ours(budget):
-                out = []
-                for method in methods:
-                    image, seconds, reached = fredholm(method, 4096, extra, workdir, seconds=budget, seed=seed)
-                    error = relmse(opts.mitsuba_python, opts.ref, image)
-                    out.append(("fredholm " + method, k, reached, seconds, error))
-                return out
+        def peer(r):
+            image, seconds = mitsuba(opts, "ldsampler", spp, workdir, 1000 * (r + 1) + spp)
+            state["budget"] = seconds
+            report(("mitsuba ldsampler", r + 1, spp, seconds, relmse(opts, image)))
 
-            # Mitsuba first in odd rounds; fredholm first in even ones, for the seconds
-            # Mitsuba took in the round before.
-            if k % 2:
-                round_rows = [peer()]
-                budget = round_rows[0][3]
-                round_rows += ours(budget)
-            else:
-                round_rows = ours(budget)
-                round_rows.append(peer())
-                budget = round_rows[-1][3]
-            rows += round_rows
-            for r in round_rows:
-                print("round", k, r[0], "spp", r[2], "seconds %.2f" % r[3], "relMSE %.4g" % r[4], flush=True)
+        def ours(r):
+            for method in methods:
+                image, seconds, reached = fredholm(opts, method, 4096, extra, workdir, seconds=state["budget"],
+                                                   seed=1000 * (r + 1) + spp)
+                report(("fredholm " + method, r + 1, reached, seconds, relmse(opts, image)))
+
+        # Mitsuba first in odd rounds; fredholm first in even ones, for the seconds Mitsuba
+        # took in the round before.
+        benchlib.alternate({"mitsuba": peer, "fredholm": ours}, opts.equal_time_rounds, warmup=False)
     names = list(dict.fromkeys(r[0] for r in rows))
     for name in names:
         mine = [r for r in rows if r[0] == name]
@@ -167,4 +147,4 @@ def equal_time_rounds(opts, extra):
 
 
 if __name__ == "__main__":
-    main()
+    benchlib.main(main)

@@ -14,74 +14,65 @@ renderer's Msamples/s per round and median, then each fredholm kernel's median t
 sample (--stats "kernels"). The first render of each is a warm-up (kernel compilation,
 Mitsuba's JIT) and is not counted.
 """
-import argparse, json, os, statistics, subprocess, tempfile
+import argparse, os, statistics, tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
-
-KERNEL_NS = {}  # runner name -> kernel -> [ns per sample, one per round]
+import benchlib
 
 
-def fredholm(binary, strategy, spp, workdir, name=None, rr_depth=None):
-    stats = os.path.join(workdir, "s.json")
+def fredholm(binary, strategy, spp, workdir, rr_depth=None):
+    """Renders; returns the --stats JSON."""
     choice = (["--strategy", strategy] if strategy else []) + (["--rr-depth", str(rr_depth)] if rr_depth else [])
-    subprocess.run([binary, "render", "--width", "512", "--height", "512", "--spp", str(spp), "--method", "mis",
-                    "--eye", "0,1,3.5", "--target", "0,1,0", "--fov", "40", "--max-depth", "16",
-                    ] + choice + ["-o", os.path.join(workdir, "f.pfm"), "--force", "--stats", stats],
-                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    with open(stats) as f:
-        st = json.load(f)
-    if name:
-        for kernel, k in st.get("kernels", {}).items():
-            KERNEL_NS.setdefault(name, {}).setdefault(kernel, []).append(k["seconds"] / st["samples"] * 1e9)
-    return st["samples_per_second"] / 1e6
+    return benchlib.render(["--spp", str(spp), "--method", "mis"] + benchlib.PEER_VIEW + choice,
+                           os.path.join(workdir, "f.pfm"), binary, stats=os.path.join(workdir, "s.json"))
 
 
-def mitsuba(python, spp, workdir):
-    script = os.path.join(ROOT, "..", "shared", "peers", "mitsuba", "cbox.py")
-    out = subprocess.run([python, script, "--variant", "llvm_ad_rgb", "--spp", str(spp), "--max-bounces", "16",
-                          "--threads", "2", "--out", os.path.join(workdir, "mi.exr")],
-                         check=True, capture_output=True, text=True).stdout
-    line = [l for l in out.splitlines() if l.startswith("{")][-1]
-    return json.loads(line)["samples_per_second"] / 1e6
+def mitsuba(opts, workdir):
+    """Renders with Mitsuba's cbox.py; returns its JSON line (samples_per_second...)."""
+    return benchlib.mitsuba(opts.mitsuba_python, "cbox.py", ["--variant", "llvm_ad_rgb", "--spp", str(opts.spp),
+                                                             "--max-bounces", "16", "--threads", "2", "--out",
+                                                             os.path.join(workdir, "mi.exr")], opts.mitsuba_dir)
 
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--rounds", type=int, default=3)
-    ap.add_argument("--spp", type=int, default=64)
-    ap.add_argument("--mitsuba-python", default="/opt/mi-venv/bin/python")
+    benchlib.add_arguments(ap, "--rounds", "--spp", "--mitsuba-python", "--mitsuba-dir", rounds=3, spp=64)
     ap.add_argument("--strategies", default="megakernel8,simd8")
-    ap.add_argument("--fredholm", default=os.path.join(ROOT, "build", "fredholm"))
+    benchlib.add_arguments(ap, "--binary")
     ap.add_argument("--baseline", help="an older fredholm binary (run without --strategy)")
     ap.add_argument("--rr-depths", default="6",
                     help="fredholm's roulette starts to run (6 is Mitsuba's rr_depth 5: the same work per sample)")
     opts = ap.parse_args()
-    runners = {"fredholm mis %s rr%s" % (s, rr): (lambda s=s, rr=rr, w=None, n=None:
-                                                    fredholm(opts.fredholm, s, opts.spp, w, n, rr))
-               for rr in opts.rr_depths.split(",") for s in opts.strategies.split(",")}
-    if opts.baseline:
-        runners["fredholm mis baseline"] = lambda w=None, n=None: fredholm(opts.baseline, None, opts.spp, w, n)
-    runners["mitsuba llvm_ad_rgb"] = lambda w=None, n=None: mitsuba(opts.mitsuba_python, opts.spp, w)
-    names = list(runners)
-    results = {n: [] for n in names}
     with tempfile.TemporaryDirectory() as workdir:
-        for n in names:
-            runners[n](w=workdir)  # warm-up
-        for r in range(opts.rounds):
-            order = names[r % len(names):] + names[:r % len(names)]
-            for n in order:
-                results[n].append(runners[n](w=workdir, n=n))
-            print("round %d: " % (r + 1) + ", ".join("%s %.3f" % (n, results[n][-1]) for n in names), flush=True)
+        def current(strategy, rr_depth):
+            return lambda r: fredholm(opts.binary, strategy, opts.spp, workdir, rr_depth)
+
+        runners = {"fredholm mis %s rr%s" % (s, rr): current(s, rr)
+                   for rr in opts.rr_depths.split(",") for s in opts.strategies.split(",")}
+        if opts.baseline:
+            runners["fredholm mis baseline"] = lambda r: fredholm(opts.baseline, None, opts.spp, workdir)
+        runners["mitsuba llvm_ad_rgb"] = lambda r: mitsuba(opts, workdir)
+        names = list(runners)
+
+        def rate(doc):
+            return doc["samples_per_second"] / 1e6
+
+        def progress(r, docs):
+            print("round %d: " % (r + 1) + ", ".join("%s %.3f" % (n, rate(docs[n][-1])) for n in names), flush=True)
+
+        docs = benchlib.alternate(runners, opts.rounds, after_round=progress)
+    results = {n: [rate(doc) for doc in docs[n]] for n in names}
     base = statistics.median(results["mitsuba llvm_ad_rgb"])
     for n in names:
-        m = statistics.median(results[n])
-        print("%-28s median %.3f Msamples/s  (%s)  %.2fx Mitsuba" % (n, m, ", ".join("%.3f" % v for v in results[n]),
-                                                                      m / base))
-    for n, kernels in KERNEL_NS.items():
-        print("%-28s ns/sample: %s" % (n, ", ".join("%s %.0f" % (k, statistics.median(v))
-                                                       for k, v in sorted(kernels.items(), key=lambda kv: -max(kv[1])))))
+        print(benchlib.median_line(n, results[n], base, "Mitsuba", width=28))
+    for n in names:  # fredholm's: each kernel's time per sample
+        kernels = {}
+        for doc in docs[n]:
+            for kernel, k in doc.get("kernels", {}).items():
+                kernels.setdefault(kernel, []).append(k["seconds"] / doc["samples"] * 1e9)
+        if kernels:
+            by_cost = sorted(kernels.items(), key=lambda kv: -max(kv[1]))
+            print("%-28s ns/sample: %s" % (n, ", ".join("%s %.0f" % (k, statistics.median(v)) for k, v in by_cost)))
 
 
 if __name__ == "__main__":
-    main()
+    benchlib.main(main)

@@ -6,8 +6,8 @@ usage: bench/plot_throughput.py bench.json [out.png]
 One line per ray kind for fredholm (solid) and, when the JSON has them, Embree's best API
 (dashed). Needs Debian's python3-matplotlib.
 """
+import argparse
 import json
-import sys
 
 import matplotlib
 
@@ -16,11 +16,13 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 
 def main():
-    if len(sys.argv) < 2:
-        sys.exit(__doc__)
-    with open(sys.argv[1]) as f:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("json", help="`fredholm bench --json` output")
+    p.add_argument("png", nargs="?", help="the chart (default: the JSON's name with .png)")
+    a = p.parse_args()
+    with open(a.json) as f:
         doc = json.load(f)
-    out = sys.argv[2] if len(sys.argv) > 2 else sys.argv[1].rsplit(".", 1)[0] + ".png"
+    out = a.png or a.json.rsplit(".", 1)[0] + ".png"
     fig, ax = plt.subplots(figsize=(7, 4.5))
     colors = {"primary": "tab:blue", "bounce": "tab:red", "shadow": "tab:green"}
     for kind, color in colors.items():

@@ -13,37 +13,35 @@ uses one seed for every depth, a new one per round. Prints each render and, per 
 medians. The renders are deterministic for a seed, so only the seconds vary between rounds
 of one seed; the seeds vary the relMSE.
 """
-import argparse, statistics, sys, tempfile
+import argparse, statistics, tempfile
 
+import benchlib
 import peer_error
 
 
 def main():
-    argv = sys.argv[1:]
-    extra = argv[argv.index("--") + 1:] if "--" in argv else []
-    argv = argv[:argv.index("--")] if "--" in argv else argv
     ap = argparse.ArgumentParser()
-    ap.add_argument("--ref", required=True, help="long reference render of the same view (EXR)")
+    benchlib.add_arguments(ap, "--ref", ref=dict(required=True, help="long reference render of the same view (EXR)"))
     ap.add_argument("--depths", default="4,5,6,7,8", help="roulette starts to compare (--rr-depth values)")
-    ap.add_argument("--spp", type=int, default=256)
-    ap.add_argument("--rounds", type=int, default=2)
-    ap.add_argument("--method", default="mis")
-    ap.add_argument("--mitsuba-python", default="/opt/mi-venv/bin/python")
-    opts = ap.parse_args(argv)
+    benchlib.add_arguments(ap, "--spp", "--rounds", "--method", "--mitsuba-python", "--mitsuba-dir", "--binary",
+                           spp=256, rounds=2)
+    opts, extra = benchlib.parse_with_rest(ap)
     depths = [int(d) for d in opts.depths.split(",")]
 
-    results = {d: [] for d in depths}  # depth -> [(relMSE, seconds)]
-    with tempfile.TemporaryDirectory() as workdir:
-        peer_error.fredholm(opts.method, 1, extra, workdir)  # fills PoCL's kernel cache
-        for r in range(opts.rounds):
+    def depth(d):  # renders with roulette from bounce d; (relMSE, seconds)
+        def render(r):
             seed = 1000 + r
-            for d in depths if r % 2 == 0 else reversed(depths):
-                image, seconds, _ = peer_error.fredholm(opts.method, opts.spp, ["--rr-depth", str(d)] + extra,
-                                                        workdir, seed=seed)
-                error = peer_error.relmse(opts.mitsuba_python, opts.ref, image)
-                results[d].append((error, seconds))
-                print(f"round {r + 1} rr-depth {d} seed {seed} seconds {seconds:.2f} relMSE {error:.4g} "
-                      f"relMSE*s {error * seconds:.4g}", flush=True)
+            image, seconds, _ = peer_error.fredholm(opts, opts.method, opts.spp, ["--rr-depth", str(d)] + extra,
+                                                    workdir, seed=seed)
+            error = peer_error.relmse(opts, image)
+            print(f"round {r + 1} rr-depth {d} seed {seed} seconds {seconds:.2f} relMSE {error:.4g} "
+                  f"relMSE*s {error * seconds:.4g}", flush=True)
+            return error, seconds
+        return render
+
+    with tempfile.TemporaryDirectory() as workdir:
+        peer_error.fredholm(opts, opts.method, 1, extra, workdir)  # fills PoCL's kernel cache
+        results = benchlib.alternate({d: depth(d) for d in depths}, opts.rounds, warmup=False, order="reverse")
     print("\n| roulette from bounce | relMSE (median) | seconds (median) | relMSE × seconds (median) |")
     print("|---|---|---|---|")
     for d in depths:
@@ -53,4 +51,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    benchlib.main(main)

@@ -6,23 +6,23 @@ grid of bumped spheres), one process per size so each starts clean, and charts M
 ray kind, BVH build seconds and bytes per triangle against the triangle count, fredholm and
 Embree on the same axes. Writes bench/results/scaling.json and bench/results/scaling.png.
 
-  bench/results/scaling.py [--sizes 1e2,1e3,...] [--repeats 5]
+  bench/scaling.py [--sizes 1e2,1e3,...] [--repeats 5]
 """
 import argparse
 import json
 import os
-import subprocess
 import tempfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+import benchlib
 
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--binary", default=os.path.join(ROOT, "build", "fredholm"))
+    benchlib.add_arguments(p, "--binary")
     p.add_argument("--sizes", default="1e2,3e2,1e3,3e3,1e4,3e4,1e5,3e5,1e6,3e6,1e7")
     p.add_argument("--repeats", type=int, default=5)
-    p.add_argument("--out", default=os.path.join(ROOT, "bench", "results", "scaling"))
+    benchlib.add_arguments(p, "--out", out=dict(default=benchlib.results_path("scaling"),
+                                                help="OUT.json and OUT.png are written"))
     p.add_argument("--replot", action="store_true", help="only redraw the chart from OUT.json")
     a = p.parse_args()
     scenes, records = [], []
@@ -31,10 +31,8 @@ def main():
         scenes, records = doc["scenes"], doc["records"]
     with tempfile.TemporaryDirectory() as tmp:
         for size in [] if a.replot else a.sizes.split(","):
-            path = os.path.join(tmp, "b.json")
-            subprocess.run([a.binary, "bench", f"spheres:{size}", "--repeats", str(a.repeats), "--json", path,
-                            "--force"], check=True, stdout=subprocess.DEVNULL)
-            doc = json.load(open(path))
+            doc = benchlib.bench([f"spheres:{size}", "--repeats", str(a.repeats)], os.path.join(tmp, "b.json"),
+                                 a.binary)
             scenes += doc["scenes"]
             records += doc["records"]
             s = doc["scenes"][0]
@@ -76,4 +74,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    benchlib.main(main)
