@@ -6,7 +6,10 @@
 // each work-item carries eight paths in the lanes of vector registers, branches become
 // selects over the lanes (taken when any lane needs them) and loads of per-path or
 // per-triangle data are gathers. PoCL does not vectorize divergent shading code across
-// work-items on its own (../shared/POCL.md, bench/RESULTS.md), so the lanes are explicit.
+// work-items on its own: written one path per work-item, shade and shadow_connect compiled
+// to scalar code, and eight explicit lanes cut shade's time about in half (see
+// docs/architecture.md; measured in bench/history/cpu_render_speed.md), so the lanes are
+// explicit.
 //
 // Masks are what comparisons return: 0 / 1 for scalars, 0 / -1 for vectors; `select`,
 // `&&`, `||`, `!`, `&` and `|` treat both alike. Vectors are lvec3 structures of lanes

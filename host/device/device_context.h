@@ -16,8 +16,8 @@ struct DeviceContext {
 };
 
 // Every kernel launch uses this local size and a global size padded to a multiple of it:
-// PoCL compiles one variant per local size, and a NULL local size on odd queue lengths
-// gives work-groups of one (see ../shared/POCL.md).
+// PoCL compiles one variant per local size, and a NULL local size lets it pick a divisor
+// of the global size: work-groups of one on odd queue lengths (docs/architecture.md).
 constexpr size_t kLocalSize = 64;
 
 void launch(const DeviceContext& dc, const cl::Kernel& kernel, size_t count, const char* name,

@@ -39,9 +39,11 @@ struct Pass {
 class PassSource {
  public:
   virtual ~PassSource() = default;
-  // The next pass for `worker`; false when the render needs no more from it. Passes that
-  // cover other pixels than the worker's last are handed out only once every earlier pass
-  // is back, so a device never has passes of two shapes in flight.
+  // The next pass for `worker`; false when the render needs no more from it. A pass may
+  // cover other pixels than the worker's last (the next adaptive round's) while earlier
+  // passes are still in flight: a device may have passes of two shapes in flight, and its
+  // worker holds a pass of a third until every sample of the oldest has started
+  // (WavefrontPipeline::fits, render/wavefront.h).
   virtual bool take(int worker, Pass& pass) = 0;
   // A finished pass's samples: rgb and 1 for each pixel it covers, in order (may be
   // swapped out: `samples` is then left empty).

@@ -83,8 +83,9 @@ class WavefrontPipeline {
   // which seed the samples. A pass covers the pixels listed (null: every pixel, each
   // pixel's sample of pass k its sequence's point k). Passes
   // are granted while they fit: FH_MAX_PASS_SLOTS unfinished at most, their samples within
-  // the pass buffers, and of two shapes at most: a pass of a new shape waits until every
-  // sample of the older one in flight has started.
+  // the pass buffers, and of two shapes at most (gpu::PassShape: runs of passes over one
+  // pixel list): a pass of a new shape waits, held by the worker, until every sample of the
+  // older one in flight has started.
   bool fits(const std::shared_ptr<const RoundPixels>& pixels, uint64_t granted, uint64_t returned) const;
   void grantPass(uint64_t local, uint32_t global, std::shared_ptr<const RoundPixels> pixels);
   // Lets the passes granted so far start; once per batch, after its grants.
