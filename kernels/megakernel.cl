@@ -5,11 +5,11 @@
 // the stages' own functions, so it computes the same estimator and the same image bits for
 // a seed. Every path it starts ends in the same launch: plan_iteration (built with
 // FH_MEGAKERNEL) carries no rays over, and the free list is left as it was.
-#include "accumulate.cl"
-#include "generate.cl"
-#include "intersect.cl"
-#include "shade.cl"
-#include "shadow_connect.cl"
+#include "accumulate_stage.h"
+#include "generate_stage.h"
+#include "intersect_stage.h"
+#include "shade_stage.h"
+#include "shadow_connect_stage.h"
 
 #ifdef FH_PRIVATE_PATHS
 // The host binds the path state's buffers to every path-tracing program; this one keeps the
@@ -42,16 +42,9 @@ FH_INLINE void count_finished(volatile __local uint* finished_in_slot, luint slo
 
 __kernel void megakernel(RenderParams params, volatile __global WavefrontCounters* counters, uint parity,
                          __global const uint* free_list, __global const float* filter_table,
-                         __global const uint* pass_table, __global const uint* pixel_list,
-                         __global const Bvh8Node* nodes,
-                         __global const TriangleBlock8* blocks, __global const float4* triangles,
-                         __global const int* triangle_material, __global const GpuMaterial* materials,
-                         __global const float* light_cdf, __global const int* light_triangle,
-                         __global const float* light_pdf_area, __global const float4* normals,
-                         __global const float2* uvs, __global const uint* texels,
-                         __global const uint4* texture_info, __global const float* env_map,
-                         __global float4* pass_buffer,
-                         __global float4* aovs FH_PATH_BUFFERS) {
+                         __global const uint* pass_table, __global const uint* pixel_list FH_SCENE_PARAMS,
+                         __global float4* pass_buffer, __global float4* aovs FH_PATH_BUFFERS) {
+  const SceneView scene = FH_SCENE_VIEW;
   // The work-group's books, added to the device's once at the end (see queue_append_each):
   // samples finished per pass slot, then bounce rays, shadow rays and non-finite samples.
   volatile __local uint finished_in_slot[FH_MAX_PASS_SLOTS], totals[3];
@@ -92,15 +85,13 @@ __kernel void megakernel(RenderParams params, volatile __global WavefrontCounter
         start_sample(params, older, newer, entries, counters->new_first + next, p, alive, filter_table, pass_table,
                      pixel_list FH_PATH_ARGS);
         next = select(next, next + slots, alive);
-        intersect_camera_lanes(nodes, blocks, p, alive, ray_org, ray_dir, hit);
+        intersect_camera_lanes(scene.nodes, scene.blocks, p, alive, ray_org, ray_dir, hit);
       } else {
-        intersect_lanes(nodes, blocks, p, alive, ray_org, ray_dir, hit);
+        intersect_lanes(scene.nodes, scene.blocks, p, alive, ray_org, ray_dir, hit);
       }
-      const ShadeOutcome o = shade_paths(params, p, alive, triangles, triangle_material, materials, light_pdf_area,
-                                         normals, uvs, texels, texture_info, env_map, aovs FH_PATH_ARGS);
+      const ShadeOutcome o = shade_paths(params, p, alive, &scene, aovs FH_PATH_ARGS);
       if (lanes_any(o.light_sample))  // never for pt, nor without lights
-        connect_light(params, &o.request, &o.sampler, o.light_sample, nodes, blocks, triangles, triangle_material,
-                      materials, light_cdf, light_triangle, light_pdf_area, env_map FH_PATH_ARGS);
+        connect_light(params, &o.request, &o.sampler, o.light_sample, &scene FH_PATH_ARGS);
       shadow_rays += lanes_count(o.light_sample);
       bounce_rays += lanes_count(o.continues);
       if (lanes_any(o.finished)) {

@@ -156,7 +156,8 @@ RenderSettings settingsFrom(const RenderOptions& o) {
 
 // --aov: first-hit albedo, normal or depth, on one device (runRender checks there is one).
 RenderResult renderDebugView(Aov mode, const std::vector<DeviceInfo>& devices, const Scene& scene,
-                             const Bvh& bvh, const Camera& camera, const RenderSettings& s) {
+                             const Bvh& bvh, const Camera& camera, const RenderSettings& s,
+                             const RenderLinks& links) {
   AovSettings a;
   a.width = s.width;
   a.height = s.height;
@@ -176,7 +177,7 @@ RenderResult renderDebugView(Aov mode, const std::vector<DeviceInfo>& devices, c
   share.name = devices[0].name;
   share.samples = r.stats.samples;
   r.stats.devices.push_back(share);
-  r.stopped = s.stopRequested();  // a debug view finishes once started
+  r.stopped = links.stopRequested();  // a debug view finishes once started
   return r;
 }
 
@@ -243,8 +244,7 @@ std::vector<std::string> planOutputs(RenderOptions& o, RenderSettings& settings,
 }
 
 // A resumed render says what it starts from, and when the checkpoint holds every pass asked for.
-void reportResume(const RenderOptions& o, const RenderSettings& settings) {
-  const Film& film = *settings.resume;
+void reportResume(const RenderOptions& o, const RenderSettings& settings, const Film& film) {
   const uint64_t held = film.nextPass(), asked = uint64_t(settings.spp);
   std::cerr << "fredholm: resuming from '" << o.resume << "': passes " << film.describePasses() << " rendered";
   if (settings.adaptive || held < asked)
@@ -292,12 +292,13 @@ std::shared_ptr<const Film> resumeRanks(const RenderOptions& o, int rank, const 
 }
 
 RenderResult renderOnEveryRank(const RenderOptions& o, const std::vector<DeviceInfo>& devices, const Scene& scene,
-                               const Bvh& bvh, const Camera& camera, const RenderSettings& settings) {
+                               const Bvh& bvh, const Camera& camera, const RenderSettings& settings,
+                               const RenderLinks& links) {
 #ifdef FREDHOLM_HAVE_MPI
-  if (o.mpi) return renderAcrossRanks(*o.mpi, devices, scene, bvh, camera, settings);
+  if (o.mpi) return renderAcrossRanks(*o.mpi, devices, scene, bvh, camera, settings, links);
 #endif
   (void)o;
-  return render(devices, scene, bvh, camera, settings);
+  return render(devices, scene, bvh, camera, settings, links);
 }
 
 // The image's radiance denoised, written with the render's metadata and what denoised it.
@@ -368,7 +369,8 @@ int runRender(RenderOptions o) {
   if (o.seconds > 0 && !o.spp && o.noise == 0 && o.passes.empty())
     std::cerr << "fredholm: --time " << o.seconds << " without --spp: as many samples per pixel as the time allows "
                  "(--spp caps them)\n";
-  settings.stop = &installInterruptHandlers();
+  RenderLinks links;
+  links.stop = &installInterruptHandlers();
   const bool debugView = !o.aov.empty();
   const Aov aov = debugView ? parseAov(o.aov) : Aov::Albedo;
   const int rank = mpiRank(o);
@@ -390,21 +392,21 @@ int runRender(RenderOptions o) {
   settings.fingerprint = renderFingerprint(scene, camera, settings);
   if (!o.resume.empty()) {
     if (debugView) throw Error("--resume goes on with a render's passes; --aov renders none");
-    settings.resume = o.mpi ? resumeRanks(o, rank, settings.fingerprint)
-                            : std::make_shared<Film>(loadCheckpoint(o.resume, settings.fingerprint, "--resume"));
+    links.resume = o.mpi ? resumeRanks(o, rank, settings.fingerprint)
+                         : std::make_shared<Film>(loadCheckpoint(o.resume, settings.fingerprint, "--resume"));
   }
-  if (settings.resume && rank == 0) reportResume(o, settings);
+  if (links.resume && rank == 0) reportResume(o, settings, *links.resume);
   plan.checkAgainstInputs();
   // rank 0's view: its own passes as they merge, then the image of all.
   std::unique_ptr<LiveView> view;
   if (display && rank == 0) {
     view = std::make_unique<LiveView>(*display, o.output.empty() ? o.film : o.output, layers);
-    settings.watcher = view.get();
+    links.watcher = view.get();
   }
   const auto start = std::chrono::steady_clock::now();
   const Bvh bvh = buildBvh(scene);
-  const RenderResult r = debugView ? renderDebugView(aov, devices, scene, bvh, camera, settings)
-                                   : renderOnEveryRank(o, devices, scene, bvh, camera, settings);
+  const RenderResult r = debugView ? renderDebugView(aov, devices, scene, bvh, camera, settings, links)
+                                   : renderOnEveryRank(o, devices, scene, bvh, camera, settings, links);
   if (rank != 0) return 0;  // rank 0 holds the film, and writes
   const std::string method = debugView ? "aov:" + o.aov : methodName(settings.method);
   reportDevices(r);
@@ -427,7 +429,7 @@ int runRender(RenderOptions o) {
     return writeOutputs(o, settings, r.film, image, facts, denoiser.get());
   };
   if (r.stopped) {
-    const int signal = settings.stop->load();
+    const int signal = links.stop->load();
     if (r.film.samples() == 0) throw Interrupted("before any pass was finished; nothing written", signal);
     metadata["incomplete"] = "interrupted by signal " + std::to_string(signal);
     throw Interrupted("wrote the " + passes + " finished so far to " + deliver(metadata) +

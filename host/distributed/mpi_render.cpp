@@ -13,6 +13,7 @@
 #include <string>
 #include <thread>
 
+#include "base/test_hooks.h"
 #include "render/pass_ledger.h"
 
 namespace fh {
@@ -25,10 +26,9 @@ using Clock = std::chrono::steady_clock;
 // render is over.
 constexpr int kTagRequest = 1, kTagPass = 2, kTagBye = 3, kTagFinished = 4;
 
-// FREDHOLM_SLOW_RANK=r: rank r is slowed on purpose (tests), as a rank on a slower machine.
+// FREDHOLM_SLOW_RANK=r (base/test_hooks.h): rank r is slowed on purpose, as a rank on a slower machine.
 void slowDownIfAsked(int rank) {
-  const char* slow = std::getenv("FREDHOLM_SLOW_RANK");
-  if (slow && *slow && std::atoi(slow) == rank) std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  if (testHooks().slowRank == rank) std::this_thread::sleep_for(std::chrono::milliseconds(200));
 }
 
 // Rank 0's ledger: the render's pass count and time budget, for its own pool (next) and,
@@ -208,16 +208,17 @@ void MpiSession::abort(int code) const {
 }
 
 RenderResult renderAcrossRanks(const MpiSession& mpi, const std::vector<DeviceInfo>& devices, const Scene& scene,
-                               const Bvh& bvh, const Camera& camera, RenderSettings settings) {
-  RootLedger root(uint32_t(std::max(1, settings.spp)), settings.seconds, settings.resume.get());
+                               const Bvh& bvh, const Camera& camera, const RenderSettings& settings,
+                               RenderLinks links) {
+  RootLedger root(uint32_t(std::max(1, settings.spp)), settings.seconds, links.resume.get());
   RemoteLedger remote(mpi.rank());
-  settings.ledger = mpi.rank() == 0 ? static_cast<PassLedger*>(&root) : &remote;
+  links.ledger = mpi.rank() == 0 ? static_cast<PassLedger*>(&root) : &remote;
   std::thread server;
   if (mpi.rank() == 0) server = std::thread([&] { root.serve(mpi.size()); });
   const double start = MPI_Wtime();
   RenderResult r;
   try {
-    r = render(devices, scene, bvh, camera, settings);
+    r = render(devices, scene, bvh, camera, settings, links);
   } catch (...) {
     // The error ends the job (MPI_Abort, cli/main.cpp); the server cannot be joined first,
     // as it waits for ranks that will never say goodbye.

@@ -42,10 +42,11 @@ class MpiSession {
 };
 
 // One render over every rank of `mpi`, each rendering on `devices` (its own); on rank 0,
-// settings.resume may hold passes done already. On rank 0 the result holds the whole film,
+// links.resume may hold passes done already. On rank 0 the result holds the whole film,
 // the totals and stats.ranks; on the others, an empty film.
 // FREDHOLM_SLOW_RANK=r (tests): rank r waits 200 ms before asking for each pass.
 RenderResult renderAcrossRanks(const MpiSession& mpi, const std::vector<DeviceInfo>& devices, const Scene& scene,
-                               const Bvh& bvh, const Camera& camera, RenderSettings settings);
+                               const Bvh& bvh, const Camera& camera, const RenderSettings& settings,
+                               RenderLinks links = {});
 
 }  // namespace fh

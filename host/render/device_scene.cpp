@@ -181,46 +181,36 @@ TextureData loadTexture(const std::string& path) {
 #endif
 }
 
-DeviceScene::DeviceScene(DeviceContext& dc, const Scene& scene, const Bvh& hostBvh, const SceneFeatures& f,
-                         const EnvironmentMap* env)
-    : bvh(dc, hostBvh), features(f) {
-  const LightTable lights = buildLightTable(scene, hostBvh, env);
-  lightCount = unsigned(lights.cdf.size());
-  environmentPick = lights.environmentPick;
+PreparedScene prepareScene(const Scene& scene, const Bvh& bvh, const SceneFeatures& f, const EnvironmentMap* env) {
+  PreparedScene prepared;
+  prepared.features = f;
+  prepared.lights = buildLightTable(scene, bvh, env);
   const EnvironmentMap black = makeEnvironmentMap("no environment map", 1, 1, {0.f, 0.f, 0.f}, 0.f, 1.f);
   const EnvironmentMap& map = env ? *env : black;
-  environmentWidth = map.width;
-  environmentHeight = map.height;
-  environmentUShift = map.uShift();
-  environment = upload(dc, map.packed(), "environment map");
-  triangleMaterial = upload(dc, toBvhOrder(scene.triangleMaterial, hostBvh.order), "triangle materials");
-  materials = upload(dc, toGpuMaterials(scene), "materials");
-  lightCdf = upload(dc, lights.cdf, "light CDF");
-  lightTriangle = upload(dc, lights.triangle, "light triangles");
-  lightPdfArea = upload(dc, lights.pdfArea, "light densities");
+  prepared.environmentWidth = map.width;
+  prepared.environmentHeight = map.height;
+  prepared.environmentUShift = map.uShift();
+  prepared.environment = map.packed();
+  prepared.triangleMaterial = toBvhOrder(scene.triangleMaterial, bvh.order);
+  prepared.materials = toGpuMaterials(scene);
 
   // Per-corner normals and UVs in BVH order, only where the scene uses them.
   // A kernel compiled with a feature the scene lacks (--all-features) gets neutral data:
   // zero normals, which the kernels read as "the geometric normal" exactly (a normal computed
   // here would differ from the kernel's in rounding, and so sample other directions), and
   // zero UVs.
-  std::vector<float> cornerNormals, cornerUVs;
   if (f.shadingNormals) {
     std::vector<float> source = scene.cornerNormals;
     if (source.empty()) source.assign(9 * scene.triangleCount(), 0.f);
-    const std::vector<float> ordered = toBvhOrder(source, hostBvh.order, 9);
+    const std::vector<float> ordered = toBvhOrder(source, bvh.order, 9);
     for (size_t i = 0; i < ordered.size(); i += 3)
-      cornerNormals.insert(cornerNormals.end(), {ordered[i], ordered[i + 1], ordered[i + 2], 0.f});
+      prepared.cornerNormals.insert(prepared.cornerNormals.end(), {ordered[i], ordered[i + 1], ordered[i + 2], 0.f});
   }
   if (f.textures)
-    cornerUVs = scene.cornerUVs.empty() ? std::vector<float>(6 * scene.triangleCount(), 0.f)
-                                        : toBvhOrder(scene.cornerUVs, hostBvh.order, 6);
-  normals = upload(dc, cornerNormals, "shading normals");
-  uvs = upload(dc, cornerUVs, "texture coordinates");
-
-  std::vector<uint32_t> allTexels, info;
+    prepared.cornerUVs = scene.cornerUVs.empty() ? std::vector<float>(6 * scene.triangleCount(), 0.f)
+                                                 : toBvhOrder(scene.cornerUVs, bvh.order, 6);
   if (f.textures) {
-    allTexels = srgbDecodeTable();
+    prepared.texels = srgbDecodeTable();
     for (size_t index = 0; index < scene.textures.size(); ++index) {
       const Texture& tex = scene.textures[index];
       TextureData t;
@@ -230,17 +220,40 @@ DeviceScene::DeviceScene(DeviceContext& dc, const Scene& scene, const Bvh& hostB
         std::string users;
         for (const Material& m : scene.materials)
           if (m.kdTexture == int(index)) users += (users.empty() ? "material '" : ", '") + m.name + "'";
-        warnings.push_back(users + ": " + e.what() + "; using a grey texel");
+        prepared.warnings.push_back(users + ": " + e.what() + "; using a grey texel");
         t.width = t.height = 1;
         t.format = TextureData::kLinearFloat;
         t.words = {floatBits(0.5f), floatBits(0.5f), floatBits(0.5f), floatBits(1.f)};
       }
-      info.insert(info.end(), {uint32_t(allTexels.size()), uint32_t(t.width), uint32_t(t.height), uint32_t(t.format)});
-      allTexels.insert(allTexels.end(), t.words.begin(), t.words.end());
+      prepared.textureInfo.insert(prepared.textureInfo.end(), {uint32_t(prepared.texels.size()), uint32_t(t.width),
+                                                               uint32_t(t.height), uint32_t(t.format)});
+      prepared.texels.insert(prepared.texels.end(), t.words.begin(), t.words.end());
     }
   }
-  texels = upload(dc, allTexels, "textures");
-  textureInfo = upload(dc, info, "texture table");
+  return prepared;
+}
+
+DeviceScene::DeviceScene(DeviceContext& dc, const PreparedScene& scene, const Bvh& hostBvh)
+    : bvh(dc, hostBvh),
+      features(scene.features),
+      lightCount(unsigned(scene.lights.cdf.size())),
+      environmentPick(scene.lights.environmentPick),
+      environmentWidth(scene.environmentWidth),
+      environmentHeight(scene.environmentHeight),
+      environmentUShift(scene.environmentUShift) {
+  buffers.nodes = bvh.nodes();
+  buffers.blocks = bvh.blocks();
+  buffers.triangles = bvh.triangles();
+  buffers.triangle_material = upload(dc, scene.triangleMaterial, "triangle materials");
+  buffers.materials = upload(dc, scene.materials, "materials");
+  buffers.light_cdf = upload(dc, scene.lights.cdf, "light CDF");
+  buffers.light_triangle = upload(dc, scene.lights.triangle, "light triangles");
+  buffers.light_pdf_area = upload(dc, scene.lights.pdfArea, "light densities");
+  buffers.normals = upload(dc, scene.cornerNormals, "shading normals");
+  buffers.uvs = upload(dc, scene.cornerUVs, "texture coordinates");
+  buffers.texels = upload(dc, scene.texels, "textures");
+  buffers.texture_info = upload(dc, scene.textureInfo, "texture table");
+  buffers.env_map = upload(dc, scene.environment, "environment map");
 }
 
 }  // namespace fh

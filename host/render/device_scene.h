@@ -5,6 +5,7 @@
 
 #include "accel/bvh.h"
 #include "accel/ray_caster.h"
+#include "kernels/scene_view.h"
 #include "scene/environment_map.h"
 #include "scene/scene.h"
 
@@ -60,12 +61,40 @@ std::vector<uint32_t> srgbDecodeTable();
 // Reads a map_Kd image through OpenImageIO (1, 3 or 4 channels); throws fh::Error.
 TextureData loadTexture(const std::string& path);
 
+// The scene's buffers as the kernels take them, from the list kernels/scene_view.h declares
+// once, in its order.
+struct SceneBuffers {
+#define FH_SCENE_BUFFER(type, name) cl::Buffer name;
+  FH_SCENE_FIELDS(FH_SCENE_BUFFER)
+#undef FH_SCENE_BUFFER
+};
+
+// The scene as every device holds it, prepared once on the host for all of them: the
+// tables in BVH order, the materials as the kernels read them, the light table, the
+// textures read and decoded, the environment map packed.
+struct PreparedScene {
+  SceneFeatures features;
+  LightTable lights;
+  std::vector<gpu::GpuMaterial> materials;
+  std::vector<int> triangleMaterial;  // BVH order
+  std::vector<float> cornerNormals;   // float4 per corner, BVH order; empty without the feature
+  std::vector<float> cornerUVs;       // float2 per corner, BVH order; empty without the feature
+  std::vector<uint32_t> texels, textureInfo;
+  std::vector<float> environment;  // kernels/environment.h's layout; a black 1x1 map when there is none
+  int environmentWidth = 1, environmentHeight = 1;
+  float environmentUShift = 0.f;
+  std::vector<std::string> warnings;  // textures that could not be read
+};
+
+// `features` may include more than the scene uses (to measure specialization); `environment`
+// may be null (no map).
+PreparedScene prepareScene(const Scene& scene, const Bvh& bvh, const SceneFeatures& features,
+                           const EnvironmentMap* environment = nullptr);
+
+// The prepared scene in one device's memory.
 class DeviceScene {
  public:
-  // `features` may include more than the scene uses (to measure specialization);
-  // `environment` may be null (no map).
-  DeviceScene(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const SceneFeatures& features,
-              const EnvironmentMap* environment = nullptr);
+  DeviceScene(DeviceContext& dc, const PreparedScene& scene, const Bvh& bvh);
 
   // Whether next-event estimation has anything to sample.
   bool hasLights() const { return lightCount > 0 || environmentPick > 0.f; }
@@ -76,10 +105,9 @@ class DeviceScene {
   float environmentPick = 0.f;
   int environmentWidth = 1, environmentHeight = 1;
   float environmentUShift = 0.f;
-  cl::Buffer environment;  // kernels/environment.h's layout; a black 1x1 map when there is none
-  cl::Buffer triangleMaterial, materials, lightCdf, lightTriangle, lightPdfArea;
-  cl::Buffer normals, uvs, texels, textureInfo;  // one-element placeholders when unused
-  std::vector<std::string> warnings;             // textures that could not be read
+  // The BVH's own and the rest; normals, uvs, texels and texture_info are one-element
+  // placeholders when unused.
+  SceneBuffers buffers;
 };
 
 }  // namespace fh

@@ -7,9 +7,9 @@
 
 namespace fh {
 
-void DeviceWorker::run(const RenderSettings& settings) {
+void DeviceWorker::run(const RenderLinks& links) {
   takePasses();
-  while ((returned_ < granted_ || held_) && !settings.stopRequested()) {
+  while ((returned_ < granted_ || held_) && !links.stopRequested()) {
     for (int i = 0; i < kIterationsPerBatch; ++i) pipeline_.enqueueIteration();
     pipeline_.readCounters();
     returnCompletePasses();

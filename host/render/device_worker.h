@@ -16,7 +16,7 @@ class DeviceWorker {
   // Renders until the source has nothing more for this device, or `stop` is set (passes in
   // flight are then dropped). Throws if the device fails; the caller then tells the source
   // (fail), which gives its passes to the others.
-  void run(const RenderSettings& settings);
+  void run(const RenderLinks& links);
   uint64_t passesDone() const { return returned_; }
 
  private:

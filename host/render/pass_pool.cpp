@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "base/error.h"
+#include "base/test_hooks.h"
 #include "render/adaptive.h"
 #include "render/checkpoint.h"
 #include "render/film_watcher.h"
@@ -26,13 +27,14 @@ uint32_t passLimit(const RenderSettings& s) {
 }
 }  // namespace
 
-PassPool::PassPool(const RenderSettings& s, int workers)
+PassPool::PassPool(const RenderSettings& s, const RenderLinks& links, int workers)
     : settings_(s),
+      links_(links),
       total_(passLimit(s)),
       start_(std::chrono::steady_clock::now()),
       outstanding_(size_t(workers)),
       done_(size_t(workers), 0),
-      film_(s.resume ? *s.resume : Film(s.width, s.height, s.surfaceAovs, s.replicates() == 2, s.firstPass)),
+      film_(links.resume ? *links.resume : Film(s.width, s.height, s.surfaceAovs, s.replicates() == 2, s.firstPass)),
       progress_(s.progress),
       lastCheckpoint_(std::chrono::steady_clock::now()) {
   // A resumed render goes on from the first pass its film lacks; a chunk starts at its first.
@@ -62,9 +64,9 @@ PassPool::PassPool(const RenderSettings& s, int workers)
     recordRounds();
   }
   // ... unless it met its noise target already (a render that stopped there).
-  noiseReached_ = s.resume && s.noise > 0.0 && film_.passes() >= kNoiseMinPasses &&
+  noiseReached_ = links.resume && s.noise > 0.0 && film_.passes() >= kNoiseMinPasses &&
                   film_.estimatedRelMse() <= s.noise;
-  if (const char* kill = std::getenv("FREDHOLM_KILL_AFTER_PASSES"); kill && *kill) killAfter_ = std::atol(kill);
+  killAfter_ = testHooks().killAfterPasses;
   merger_ = std::thread([this] { mergeInOrder(); });
 }
 
@@ -93,7 +95,7 @@ bool PassPool::take(int worker, Pass& pass) {
     started_ = true;
   }
   for (;;) {
-    if (settings_.stopRequested()) return false;
+    if (links_.stopRequested()) return false;
     if (!requeued_.empty()) {
       pass.index = requeued_.front();
       requeued_.pop_front();
@@ -125,9 +127,9 @@ bool PassPool::mergerBehind() const {
 // the next in this process's count, while the sample count (an adaptive render's sample
 // budget) and the time budget allow; Later at the end of an adaptive round.
 PassPool::NewPass PassPool::nextNewPass(uint32_t& pass) {
-  if (settings_.ledger) {
+  if (links_.ledger) {
     if (ledgerDry_) return NewPass::None;
-    if (settings_.ledger->next(pass)) return NewPass::Given;
+    if (links_.ledger->next(pass)) return NewPass::Given;
     ledgerDry_ = true;  // ask no more: for another process, each question is a message
     return NewPass::None;
   }
@@ -207,7 +209,7 @@ Film PassPool::finish(bool& complete) {
   }
   pending_.clear();
   spare_.clear();  // a frame of samples each
-  if (settings_.ledger) progress_.end();  // other processes may still be rendering
+  if (links_.ledger) progress_.end();  // other processes may still be rendering
   else progress_.finish(uint64_t(mergedSamples_ - resumedSamples_), secondsSince(start_), steadyRate(), firstPassSeconds());
   return std::move(film_);  // not a copy of its sums (64 bytes a pixel): the pool is done with it
 }
@@ -296,7 +298,7 @@ bool PassPool::anyOutstanding() const {
 // they join as they come. A pass is added outside the lock: workers hand over passes meanwhile.
 void PassPool::mergeInOrder() {
   std::unique_lock<std::mutex> lock(mutex_);
-  const bool anyOrder = settings_.ledger != nullptr;
+  const bool anyOrder = links_.ledger != nullptr;
   for (;;) {
     changed_.wait(lock, [&] { return stopping_ || (anyOrder ? !pending_.empty() : pending_.count(nextToMerge_) > 0); });
     const auto next = anyOrder ? pending_.begin() : pending_.find(nextToMerge_);
@@ -308,10 +310,10 @@ void PassPool::mergeInOrder() {
     const Round round = *roundOf(pass);  // the merger alone adds and drops rounds
     lock.unlock();
     film_.addPass(pass, samples, round.list());
-    if (settings_.watcher && settings_.watcher->wantsFrame()) settings_.watcher->show(film_);
+    if (links_.watcher && links_.watcher->wantsFrame()) links_.watcher->show(film_);
     const bool check = settings_.noise > 0.0 && film_.passes() >= kNoiseMinPasses;
     const double estimate = check ? film_.estimatedRelMse() : -1.0;
-    if (settings_.ledger) settings_.ledger->finished(pass);
+    if (links_.ledger) links_.ledger->finished(pass);
     // At an adaptive round's choice point, the round after it is chosen.
     const bool chooses = settings_.adaptive && pass + 1 == adaptiveChoicePoint(round.begin);
     auto following = chooses ? pixelsOfRoundAfter(round.begin) : nullptr;
@@ -388,7 +390,7 @@ void PassPool::showProgress() {
   const double noiseShare = noiseEstimate_ > 0.0 ? std::min(1.0, settings_.noise / noiseEstimate_) : 0.0;
   // This run's work only: a chunk's passes, or those a resumed render adds to its checkpoint.
   const uint64_t passes = total_ - std::min(total_, firstNew_);
-  const uint64_t elsewhere = settings_.ledger ? settings_.ledger->finishedElsewhere() : 0;
+  const uint64_t elsewhere = links_.ledger ? links_.ledger->finishedElsewhere() : 0;
   const uint64_t samples = settings_.adaptive ? sampleBudget_ - uint64_t(resumedSamples_) : passes * film_.pixels();
   progress_.update(uint64_t(mergedSamples_ - resumedSamples_) + elsewhere * film_.pixels(), timed || noisy ? 0 : samples, elapsed,
                    noisy ? std::min(1.0, std::max(noiseShare, timed ? elapsed / settings_.seconds : 0.0))

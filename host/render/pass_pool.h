@@ -33,7 +33,7 @@ namespace fh {
 
 class PassPool : public PassSource {
  public:
-  PassPool(const RenderSettings& s, int workers);
+  PassPool(const RenderSettings& s, const RenderLinks& links, int workers);
   ~PassPool() override;
 
   bool take(int worker, Pass& pass) override;
@@ -83,6 +83,7 @@ class PassPool : public PassSource {
   mutable std::mutex mutex_;
   std::condition_variable changed_;  // passes finished, or came back from a failed worker
   const RenderSettings settings_;
+  const RenderLinks links_;
   const uint32_t total_;
   std::chrono::steady_clock::time_point start_;  // when the first pass was handed out
   bool started_ = false;

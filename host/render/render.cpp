@@ -10,6 +10,7 @@
 #include <mutex>
 #include <thread>
 
+#include "base/test_hooks.h"
 #include "render/device_worker.h"
 #include "render/pass_pool.h"
 
@@ -18,14 +19,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// FREDHOLM_FAIL_DEVICE=i:n: device i fails when it finishes its (n+1)-th pass.
+// FREDHOLM_FAIL_DEVICE=i:n (base/test_hooks.h): device i fails when it finishes its (n+1)-th pass.
 long simulatedFailure(int device) {
-  const char* spec = std::getenv("FREDHOLM_FAIL_DEVICE");
-  if (!spec || !*spec) return -1;
-  const std::string s(spec);
-  const auto colon = s.find(':');
-  if (colon == std::string::npos || std::stoi(s.substr(0, colon)) != device) return -1;
-  return std::stol(s.substr(colon + 1));
+  const TestHooks::DeviceFailure& failure = testHooks().failDevice;
+  return failure.device == device ? failure.afterPasses : -1;
 }
 
 // Every device builds its program and uploads the scene first; passes are handed out
@@ -61,10 +58,19 @@ struct Device {
 class Render {
  public:
   Render(const std::vector<Device>& devices, const Scene& scene, const Bvh& bvh, const Camera& camera,
-         const RenderSettings& settings)
-      : devices_(devices), scene_(scene), bvh_(bvh), camera_(camera), settings_(settings),
-        pool_(settings, int(devices.size())), startLine_(devices.size()), shares_(devices.size()),
-        counts_(devices.size()), ends_(devices.size()), errors_(devices.size()), warnings_(devices.size()) {}
+         const RenderSettings& settings, const RenderLinks& links)
+      : devices_(devices),
+        scene_(prepareScene(scene, bvh, featuresFor(scene, settings), settings.envMap.get())),
+        bvh_(bvh),
+        camera_(camera),
+        settings_(settings),
+        links_(links),
+        pool_(settings, links, int(devices.size())),
+        startLine_(devices.size()),
+        shares_(devices.size()),
+        counts_(devices.size()),
+        ends_(devices.size()),
+        errors_(devices.size()) {}
 
   RenderResult run() {
     std::vector<std::thread> threads;
@@ -89,12 +95,11 @@ class Render {
       WavefrontPipeline pipeline(dc, scene_, bvh_, camera_, perDevice);
       share.wavefront = pipeline.wavefront();
       share.strategy = strategyName(pipeline.strategy());
-      warnings_[i] = pipeline.sceneWarnings();
       started = true;
       startLine_.arrive();
       begin = Clock::now();
-      DeviceWorker(int(i), pipeline, pool_, simulatedFailure(int(i))).run(settings_);
-      if (settings_.stopRequested()) pool_.fail(int(i));  // wakes workers waiting for its passes
+      DeviceWorker(int(i), pipeline, pool_, simulatedFailure(int(i))).run(links_);
+      if (links_.stopRequested()) pool_.fail(int(i));  // wakes workers waiting for its passes
       FH_CL(dc.queue.finish());
       counts_[i] = pipeline.stats();
     } catch (const std::exception& e) {
@@ -112,14 +117,13 @@ class Render {
   RenderResult collect(double seconds) {
     uint64_t passes = 0;
     for (size_t i = 0; i < devices_.size(); ++i) passes += pool_.passesDone(int(i));
-    if (passes == 0 && !settings_.stopRequested() &&
+    if (passes == 0 && !links_.stopRequested() &&
         std::all_of(errors_.begin(), errors_.end(), [](const auto& e) { return e != nullptr; }))
       std::rethrow_exception(errors_.front());
     RenderResult result;
     result.film = pool_.finish(result.complete);
-    result.stopped = settings_.stopRequested();
-    for (const auto& w : warnings_)
-      if (result.warnings.empty()) result.warnings = w;
+    result.stopped = links_.stopRequested();
+    result.warnings = scene_.warnings;
     for (const auto& w : pool_.warnings()) result.warnings.push_back(w);
     RenderStats& st = result.stats;
     st.seconds = seconds;
@@ -138,32 +142,32 @@ class Render {
   }
 
   const std::vector<Device>& devices_;
-  const Scene& scene_;
+  const PreparedScene scene_;  // once for every device
   const Bvh& bvh_;
   const Camera& camera_;
   const RenderSettings& settings_;
+  const RenderLinks& links_;
   PassPool pool_;
   StartLine startLine_;
   std::vector<RenderStats::DeviceShare> shares_;
   std::vector<RenderStats> counts_;
   std::vector<Clock::time_point> ends_;
   std::vector<std::exception_ptr> errors_;
-  std::vector<std::vector<std::string>> warnings_;  // every device reads the same scene: shown once
 };
 
 }  // namespace
 
 RenderResult render(const std::vector<DeviceInfo>& devices, const Scene& scene, const Bvh& bvh, const Camera& camera,
-                    const RenderSettings& settings) {
+                    const RenderSettings& settings, const RenderLinks& links) {
   std::vector<Device> list;
   for (const auto& d : devices) list.push_back({d, nullptr});
-  return Render(list, scene, bvh, camera, settings).run();
+  return Render(list, scene, bvh, camera, settings, links).run();
 }
 
 RenderResult render(DeviceContext& device, const Scene& scene, const Bvh& bvh, const Camera& camera,
-                    const RenderSettings& settings) {
+                    const RenderSettings& settings, const RenderLinks& links) {
   const std::vector<Device> list = {{device.info, &device}};
-  return Render(list, scene, bvh, camera, settings).run();
+  return Render(list, scene, bvh, camera, settings, links).run();
 }
 
 }  // namespace fh

@@ -22,7 +22,7 @@ struct RenderResult {
   Film film;
   RenderStats stats;      // totals, with stats.devices holding each device's share
   bool complete = true;      // false if a pass was never rendered (every device failed, or stopped)
-  bool stopped = false;      // settings.stop was set: the film holds the passes finished before it
+  bool stopped = false;      // links.stop was set: the film holds the passes finished before it
   std::vector<std::string> warnings;  // from setting the scene up on the devices (unreadable textures)
 };
 
@@ -30,10 +30,10 @@ struct RenderResult {
 // rendered by the others. If all fail, the result holds the passes finished so far.
 // FREDHOLM_FAIL_DEVICE=i:n (tests) makes device i fail on finishing its (n+1)-th pass.
 RenderResult render(const std::vector<DeviceInfo>& devices, const Scene& scene, const Bvh& bvh, const Camera& camera,
-                    const RenderSettings& settings);
+                    const RenderSettings& settings, const RenderLinks& links = {});
 
 // The same on a device already set up (tests render many times on one context).
 RenderResult render(DeviceContext& device, const Scene& scene, const Bvh& bvh, const Camera& camera,
-                    const RenderSettings& settings);
+                    const RenderSettings& settings, const RenderLinks& links = {});
 
 }  // namespace fh

@@ -74,6 +74,11 @@ struct RenderSettings {
   std::string checkpointPath;
   double checkpointSeconds = 60.0;
   std::string fingerprint;
+};
+
+// What a render is wired to while it runs, apart from the values above that say what it
+// computes: the film it goes on from, who hands out its passes, who watches, what stops it.
+struct RenderLinks {
   // --resume: a saved film to go on from (it holds passes 0 .. resume->passes() - 1).
   std::shared_ptr<const Film> resume;
   // Where new passes come from when several processes share the render (render/pass_ledger.h;

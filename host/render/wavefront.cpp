@@ -30,6 +30,13 @@ class ArgumentList {
 #undef FH_ARGUMENT
     return *this;
   }
+  // Every scene buffer, in FH_SCENE_FIELDS order: a kernel's FH_SCENE_PARAMS.
+  ArgumentList& operator<<(const SceneBuffers& b) {
+#define FH_ARGUMENT(type, name) *this << b.name;
+    FH_SCENE_FIELDS(FH_ARGUMENT)
+#undef FH_ARGUMENT
+    return *this;
+  }
   // Every light-sample request field: FH_SHADOW_PARAMS.
   ArgumentList& operator<<(const ShadowRequestBuffers& r) {
 #define FH_ARGUMENT(type, name, bytes) *this << r.name;
@@ -37,11 +44,27 @@ class ArgumentList {
 #undef FH_ARGUMENT
     return *this;
   }
+  // A list that binds fewer or more arguments than the kernel has is a bug here, caught
+  // before any launch.
+  void expectComplete(const char* what) const {
+    const cl_uint expected = kernel_.getInfo<CL_KERNEL_NUM_ARGS>();
+    if (next_ != expected)
+      throw Error(std::string("internal error: ") + what + " bound " + std::to_string(next_) + " arguments of " +
+                  std::to_string(expected));
+  }
 
  private:
   cl::Kernel& kernel_;
   cl_uint next_ = 0;
 };
+
+// Binds `values` to `kernel`'s parameters in order, all of them.
+template <typename... T>
+void bindAll(cl::Kernel& kernel, const char* what, const T&... values) {
+  ArgumentList list(kernel);
+  (list << ... << values);
+  list.expectComplete(what);
+}
 
 gpu::RenderParams renderParams(const RenderSettings& s, const Camera& camera, const DeviceScene& scene,
                                std::vector<float>& filterTable) {
@@ -105,12 +128,12 @@ size_t defaultWavefront(const DeviceInfo& device, size_t pixels) {
   return std::max<size_t>(kLocalSize, std::min(preferred, 2 * pixels));
 }
 
-WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const Camera& camera,
-                                     const RenderSettings& s)
+WavefrontPipeline::WavefrontPipeline(DeviceContext& dc, const PreparedScene& scene, const Bvh& bvh,
+                                     const Camera& camera, const RenderSettings& s)
     : dc_(dc),
       method_(s.method),
       strategy_(strategyFor(dc.info, s.strategy)),
-      scene_(dc, scene, bvh, featuresFor(scene, s), s.envMap.get()),
+      scene_(dc, scene, bvh),
       pixels_(unsigned(s.width) * unsigned(s.height)),
       surfaceAovs_(s.surfaceAovs),
       listsPixels_(s.adaptive) {
@@ -193,33 +216,28 @@ void WavefrontPipeline::allocateBuffers(const std::vector<float>& filterTable) {
 // parameter lists in kernels/<stage>.cl.
 void WavefrontPipeline::bindArguments(unsigned parity) {
   auto& k = kernels_[parity];
-  auto args = [&](Stage s) { return ArgumentList(k[size_t(s)]); };
   const cl::Buffer& rays = queues_.rays[parity];
   const cl::Buffer& nextRays = queues_.rays[1 - parity];
-  const DeviceScene& sc = scene_;
+  const SceneBuffers& scene = scene_.buffers;
 
-  args(Stage::PlanIteration) << queues_.counters << parity;
-  args(Stage::FinishIteration) << queues_.counters << parity;
+  auto bind = [&](Stage stage, const auto&... values) {
+    bindAll(k[size_t(stage)], stageInfo(stage).kernel, values...);
+  };
+  bind(Stage::PlanIteration, queues_.counters, parity);
+  bind(Stage::FinishIteration, queues_.counters, parity);
   if (isMegakernel(strategy_)) {
-    ArgumentList(megakernels_[parity])
-        << params_ << queues_.counters << parity << queues_.freeSlots << filterTable_ << passTableBuffer_
-        << pixelListBuffer_ << sc.bvh.nodes() << sc.bvh.blocks() << sc.bvh.triangles() << sc.triangleMaterial
-        << sc.materials << sc.lightCdf << sc.lightTriangle << sc.lightPdfArea << sc.normals << sc.uvs << sc.texels
-        << sc.textureInfo << sc.environment << passBuffers_ << aovBuffers_ << paths_;
+    bindAll(megakernels_[parity], kMegakernel.kernel, params_, queues_.counters, parity, queues_.freeSlots,
+            filterTable_, passTableBuffer_, pixelListBuffer_, scene, passBuffers_, aovBuffers_, paths_);
     return;
   }
-  args(Stage::Generate) << params_ << queues_.counters << queues_.freeSlots << rays << filterTable_
-                        << passTableBuffer_ << pixelListBuffer_ << paths_;
-  args(Stage::Intersect) << sc.bvh.nodes() << sc.bvh.blocks() << rays << queues_.counters << parity
-                         << paths_.ray_org << paths_.ray_dir << paths_.hit;
-  args(Stage::Shade) << params_ << rays << nextRays << queues_.finished << queues_.counters << parity
-                     << sc.bvh.triangles() << sc.triangleMaterial << sc.materials << sc.lightPdfArea << sc.normals
-                     << sc.uvs << sc.texels << sc.textureInfo << sc.environment << aovBuffers_ << paths_
-                     << shadowRequests_;
-  args(Stage::ShadowConnect) << params_ << queues_.counters << sc.bvh.nodes() << sc.bvh.blocks()
-                             << sc.bvh.triangles() << sc.triangleMaterial << sc.materials << sc.lightCdf
-                             << sc.lightTriangle << sc.lightPdfArea << sc.environment << paths_ << shadowRequests_;
-  args(Stage::Accumulate) << queues_.finished << queues_.counters << queues_.freeSlots << passBuffers_ << paths_;
+  bind(Stage::Generate, params_, queues_.counters, queues_.freeSlots, rays, filterTable_, passTableBuffer_,
+       pixelListBuffer_, paths_);
+  bind(Stage::Intersect, scene.nodes, scene.blocks, rays, queues_.counters, parity, paths_.ray_org, paths_.ray_dir,
+       paths_.hit);
+  bind(Stage::Shade, params_, rays, nextRays, queues_.finished, queues_.counters, parity, scene, aovBuffers_, paths_,
+       shadowRequests_);
+  bind(Stage::ShadowConnect, params_, queues_.counters, scene, paths_, shadowRequests_);
+  bind(Stage::Accumulate, queues_.finished, queues_.counters, queues_.freeSlots, passBuffers_, paths_);
 }
 
 // Each stage is launched over the whole wavefront and reads its queue's length on the

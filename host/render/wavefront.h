@@ -73,7 +73,8 @@ size_t defaultWavefront(const DeviceInfo& device, size_t pixels);
 
 class WavefrontPipeline {
  public:
-  WavefrontPipeline(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const Camera& camera,
+  // `scene`: prepareScene(scene, bvh, featuresFor(scene, s), s.envMap), once for all devices.
+  WavefrontPipeline(DeviceContext& dc, const PreparedScene& scene, const Bvh& bvh, const Camera& camera,
                     const RenderSettings& s);
 
   // One iteration over every path in flight; returns at once (the device runs it later).
@@ -104,8 +105,6 @@ class WavefrontPipeline {
   RenderStats stats();
   size_t wavefront() const { return wavefront_; }
   Strategy strategy() const { return strategy_; }
-  // What uploading the scene found (textures that could not be read).
-  const std::vector<std::string>& sceneWarnings() const { return scene_.warnings; }
 
  private:
   // The stages; each launches its kernel, bound for the current parity.
