@@ -26,16 +26,14 @@ struct Layers {
 
 constexpr int kSize = 16;
 
-Layers renderLayers(const Scene& scene, const Camera& camera, int spp, Method method = Method::MIS) {
-  DeviceContext& dc = test::defaultDevice();
-  const Bvh bvh = buildBvh(scene);
+// The layers of 8 samples per pixel under a white sky.
+Layers renderLayers(const Scene& scene, const Camera& camera) {
   RenderSettings s = test::renderSettings();
   s.width = s.height = kSize;
-  s.spp = spp;
-  s.method = method;
+  s.spp = 8;
   s.env = {1.f, 1.f, 1.f};
   s.surfaceAovs = true;
-  const RenderResult r = fh::render(dc, scene, bvh, camera, s);
+  const RenderResult r = test::render(scene, camera, s);
   return {r.film, r.film.albedo(), r.film.normal(), r.film.depth()};
 }
 
@@ -80,7 +78,7 @@ void expectSurfaceAt(const Layers& l, int i, int j, const std::array<float, 3>& 
 TEST(SurfaceAovs, DiffusePlaneAndEmptySky) {
   const Scene scene = writeAndLoad("half", "newmtl paint\nKd 0.2 0.4 0.6\n",
                                    "v -10 -10 0\nv 0 -10 0\nv 0 10 0\nv -10 10 0\nusemtl paint\nf 1 2 3 4\n");
-  const Layers l = renderLayers(scene, lookingDown(3.f), 8);
+  const Layers l = renderLayers(scene, lookingDown(3.f));
   for (int j = 0; j < kSize; ++j)
     for (int i = 0; i < kSize; ++i) {
       const size_t p = size_t(j * kSize + i);
@@ -104,7 +102,7 @@ TEST(SurfaceAovs, LookThroughMirrorsToTheFirstNonSpecularSurface) {
       "v -10 -10 0\nv 10 -10 0\nv 10 10 0\nv -10 10 0\n"
       "v -30 -30 5\nv 30 -30 5\nv 30 30 5\nv -30 30 5\n"
       "usemtl mirror\nf 1 2 3 4\nusemtl wall\nf 8 7 6 5\n");
-  const Layers l = renderLayers(scene, lookingDown(2.f), 8);
+  const Layers l = renderLayers(scene, lookingDown(2.f));
   for (int j = 0; j < kSize; ++j)
     for (int i = 0; i < kSize; ++i) {
       SCOPED_TRACE("pixel " + std::to_string(i) + "," + std::to_string(j));

@@ -51,6 +51,21 @@ TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
   EXPECT_FALSE(std::filesystem::exists(dir + "/x.png"));
 }
 
+// The test hooks (base/test_hooks.h) are checked as flags are: a malformed value is one line
+// naming the variable, not a hook silently off or an internal error.
+TEST(RenderCli, MalformedTestHooksAreOneLineErrorsNamingTheVariable) {
+  const std::string dir = test::tempDir("cli-hooks");
+  for (const char* hook : {"FREDHOLM_KILL_AFTER_PASSES=three", "FREDHOLM_FAIL_DEVICE=1", "FREDHOLM_FAIL_DEVICE=1:x",
+                           "FREDHOLM_FAIL_DEVICE=-1:2", "FREDHOLM_SLOW_RANK=1.5"}) {
+    const auto r = test::runFredholm("render --width 8 --height 8 --spp 1 -o " + dir + "/x.png", hook);
+    const std::string name = std::string(hook).substr(0, std::string(hook).find('='));
+    EXPECT_EQ(r.exitCode, 1) << hook << ": " << r.output;
+    EXPECT_NE(r.output.find("fredholm: error: " + name + "='"), std::string::npos) << hook << ": " << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << hook << ": " << r.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.png"));
+}
+
 TEST(RenderCli, StatsAndExrMetadata) {
   const std::string dir = test::tempDir("cli");
   const auto r = test::runFredholm("render --width 16 --height 12 --spp 3 --method nee --seed 7 -o " + dir +

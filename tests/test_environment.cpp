@@ -64,18 +64,6 @@ Camera lookingAt(const float3& eye, const float3& target, const float3& up, floa
   return c;
 }
 
-Film renderFilm(const Scene& scene, const Camera& camera, Method method, int spp,
-                std::shared_ptr<const EnvironmentMap> map, float3 env = {}) {
-  RenderSettings s = test::renderSettings();
-  s.width = s.height = kSize;
-  s.spp = spp;
-  s.method = method;
-  s.envMap = std::move(map);
-  s.env = env;
-  const Bvh bvh = buildBvh(scene);
-  return fh::render(test::defaultDevice(), scene, bvh, camera, s).film;
-}
-
 // The mean over pixels [first, last) of the channel average, and its standard error.
 struct Estimate {
   double mean = 0.0, error = 0.0;
@@ -136,11 +124,15 @@ INSTANTIATE_TEST_SUITE_P(Environment, EveryMethod, ::testing::Values(Method::PT,
 // in view shares light sampling with the map: the pick's probability must cancel.
 TEST_P(EveryMethod, TiltedPlaneUnderTheUpperHemisphereMatchesItsViewFactor) {
   const float albedo = 0.5f, radiance = 2.f;
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = kSize;
+  s.spp = 64;
+  s.method = GetParam();
+  s.envMap = upperHemisphere(radiance);
   for (double degrees : {0.0, 60.0, 120.0}) {
     const double alpha = degrees * kPi / 180.0;
     const float3 normal{float(std::sin(alpha)), float(std::cos(alpha)), 0.f};
-    const Film film = renderFilm(squareFacing(normal, albedo, 200.f), facingSquare(normal), GetParam(), 64,
-                                 upperHemisphere(radiance));
+    const Film film = test::render(squareFacing(normal, albedo, 200.f), facingSquare(normal), s).film;
     expectMean(estimate(film), albedo * radiance * (1.0 + std::cos(alpha)) / 2.0,
                "tilted " + std::to_string(degrees) + " degrees");
   }
@@ -159,10 +151,14 @@ TEST_P(EveryMethod, VerticalPlaneUnderAQuarterOfTheSkyTurnedByRotate) {
     float rotate;
     double share;  // of rho L
   };
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = kSize;
+  s.spp = 64;
+  s.method = GetParam();
   for (const Case& c : {Case{east, 0.f, 0.5}, Case{west, 0.f, 0.0}, Case{south, 0.f, 0.25}, Case{north, 90.f, 0.5},
                         Case{east, 90.f, 0.25}, Case{west, 180.f, 0.5}, Case{east, 180.f, 0.0}}) {
-    const Film film = renderFilm(squareFacing(c.normal, albedo), facingSquare(c.normal), GetParam(), 64,
-                                 upperEastQuarter(radiance, c.rotate));
+    s.envMap = upperEastQuarter(radiance, c.rotate);
+    const Film film = test::render(squareFacing(c.normal, albedo), facingSquare(c.normal), s).film;
     expectMean(estimate(film), albedo * radiance * c.share,
                "normal " + std::to_string(c.normal[0]) + "," + std::to_string(c.normal[2]) + " rotate " +
                    std::to_string(c.rotate));
@@ -181,8 +177,12 @@ TEST_P(EveryMethod, WhiteFurnaceTheAlbedoOneSphereVanishes) {
     scene.indices.insert(scene.indices.end(), f.begin(), f.end());
     scene.triangleMaterial.push_back(m);
   }
-  const Film film = renderFilm(scene, lookingAt({0.f, 0.f, 3.f}, {0.f, 0.f, 0.f}, {0.f, 1.f, 0.f}, 45.f), GetParam(),
-                               64, mapOf(32, 16, [](int, int) { return float3{1.f, 1.f, 1.f}; }));
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = kSize;
+  s.spp = 64;
+  s.method = GetParam();
+  s.envMap = mapOf(32, 16, [](int, int) { return float3{1.f, 1.f, 1.f}; });
+  const Film film = test::render(scene, lookingAt({0.f, 0.f, 3.f}, {0.f, 0.f, 0.f}, {0.f, 1.f, 0.f}, 45.f), s).film;
   expectMean(estimate(film), 1.0, "whole image");
   const Image image = film.image();
   for (size_t p = 0; p < film.pixels(); ++p) {
@@ -203,11 +203,15 @@ TEST(EnvironmentMap, BesideATriangleLightEveryMethodAgrees) {
   b.quadFacing({0.4f, 1.5f, -0.6f}, {0.8f, 1.5f, -0.6f}, {0.8f, 1.5f, -0.2f}, {0.4f, 1.5f, -0.2f}, {0, 0, 0}, lamp);
   const Scene scene = b.build();
   const Camera camera = lookingAt({1.5f, 1.2f, 3.f}, {0.f, 0.6f, 0.f}, {0.f, 1.f, 0.f}, 50.f);
-  const auto sky = upperEastQuarter(1.5f, 30.f);
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = kSize;
+  s.spp = 256;
+  s.envMap = upperEastQuarter(1.5f, 30.f);
   std::vector<Estimate> halves[3];
   const Method methods[] = {Method::PT, Method::NEE, Method::MIS};
   for (int i = 0; i < 3; ++i) {
-    const Film film = renderFilm(scene, camera, methods[i], 256, sky);
+    s.method = methods[i];
+    const Film film = test::render(scene, camera, s).film;
     const size_t half = film.pixels() / 2;
     halves[i] = {estimate(film, 0, half), estimate(film, half, film.pixels())};
   }
@@ -229,9 +233,19 @@ TEST(EnvironmentMap, AConstantMapEqualsConstantEnv) {
   const Scene scene = b.build();
   const Camera camera = lookingAt({1.f, 1.5f, 3.f}, {0.f, 0.5f, 0.f}, {0.f, 1.f, 0.f}, 50.f);
   const float3 env{0.8f, 0.5f, 0.3f};
-  const Film reference = renderFilm(scene, camera, Method::PT, 256, nullptr, env);
+  RenderSettings constant = test::renderSettings();
+  constant.width = constant.height = kSize;
+  constant.spp = 256;
+  constant.method = Method::PT;
+  constant.env = env;
+  const Film reference = test::render(scene, camera, constant).film;
   for (Method method : {Method::NEE, Method::MIS}) {
-    const Film film = renderFilm(scene, camera, method, 256, mapOf(16, 8, [&](int, int) { return env; }));
+    RenderSettings s = test::renderSettings();
+    s.width = s.height = kSize;
+    s.spp = 256;
+    s.method = method;
+    s.envMap = mapOf(16, 8, [&](int, int) { return env; });
+    const Film film = test::render(scene, camera, s).film;
     for (size_t block = 0; block < 4; ++block) {
       const size_t first = block * film.pixels() / 4, last = (block + 1) * film.pixels() / 4;
       const Estimate a = estimate(reference, first, last), e = estimate(film, first, last);
@@ -252,6 +266,9 @@ TEST(EnvironmentMap, TheCameraSeesTheMapAsDrawnTexelByTexel) {
   const Scene scene = b.build();  // one small quad behind the camera
   const Camera camera = lookingAt({0.f, 0.f, 0.f}, {0.f, 0.f, -1.f}, {0.f, 1.f, 0.f}, 100.f);
   const double t = std::tan(50.0 * kPi / 180.0);
+  RenderSettings settings = test::renderSettings();
+  settings.width = settings.height = kSize;
+  settings.spp = 16;
   for (float rotate : {0.f, 90.f, -135.f}) {
     const auto map = mapOf(kWidth, kHeight, [](int x, int y) { return float3{float(x + 1), float(y + 1), 0.5f}; },
                            rotate);
@@ -263,7 +280,8 @@ TEST(EnvironmentMap, TheCameraSeesTheMapAsDrawnTexelByTexel) {
       u -= std::floor(u);
       return std::array<int, 2>{std::min(int(u * kWidth), kWidth - 1), std::min(int(v * kHeight), kHeight - 1)};
     };
-    const Image image = renderFilm(scene, camera, Method::MIS, 16, map).image();
+    settings.envMap = map;
+    const Image image = test::render(scene, camera, settings).film.image();
     int checked = 0;
     for (int j = 0; j < kSize; ++j)
       for (int i = 0; i < kSize; ++i) {

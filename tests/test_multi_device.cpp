@@ -11,6 +11,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "base/test_hooks.h"
 #include "render/render.h"
 #include "scene/scene_loader.h"
 #include "test_support.h"
@@ -34,6 +35,13 @@ struct TwoDevices : ::testing::Test {
     s.seed = 9;
     return s;
   }();
+  // The render with `failure` in place (FREDHOLM_FAIL_DEVICE=I:N, base/test_hooks.h).
+  RenderResult renderFailing(const std::vector<DeviceInfo>& on, TestHooks::DeviceFailure failure) {
+    TestHooks hooks = testHooks();
+    hooks.failDevice = failure;
+    const ScopedTestHooks failing(hooks);
+    return render(on, scene, bvh, scene.camera, settings);
+  }
 };
 
 TEST_F(TwoDevices, BothWorkAndTheMergeEqualsOneDevicesSamples) {
@@ -118,9 +126,7 @@ TEST_F(TwoDevices, ANoiseTargetStopsAtTheSamePassAsOneDevice) {
 TEST_F(TwoDevices, AFailingDeviceLosesNothingAndCountsNothingTwice) {
   const auto all = devices();
   const RenderResult reference = render(all, scene, bvh, scene.camera, settings);
-  setenv("FREDHOLM_FAIL_DEVICE", "1:3", 1);
-  const RenderResult failed = render(all, scene, bvh, scene.camera, settings);
-  unsetenv("FREDHOLM_FAIL_DEVICE");
+  const RenderResult failed = renderFailing(all, {1, 3});
   ASSERT_TRUE(failed.complete);
   EXPECT_NE(failed.stats.devices[1].error.find("simulated failure"), std::string::npos);
   EXPECT_EQ(failed.stats.devices[1].samples, 3u * 24u * 24u);  // the passes it finished before failing
@@ -131,9 +137,7 @@ TEST_F(TwoDevices, AFailingDeviceLosesNothingAndCountsNothingTwice) {
 
 TEST_F(TwoDevices, WhenEveryDeviceFailsTheImageSoFarIsKept) {
   const auto all = devices();
-  setenv("FREDHOLM_FAIL_DEVICE", "0:2", 1);
-  const RenderResult r = render({all[0]}, scene, bvh, scene.camera, settings);
-  unsetenv("FREDHOLM_FAIL_DEVICE");
+  const RenderResult r = renderFailing({all[0]}, {0, 2});
   EXPECT_FALSE(r.complete);
   EXPECT_EQ(r.stats.samples, 2u * 24u * 24u);
   for (size_t p = 0; p < 24u * 24u; ++p) EXPECT_EQ(r.film.count(p), 2.0) << p;

@@ -17,26 +17,22 @@
 namespace fh {
 namespace {
 
-Film renderFilm(const Scene& scene, int width, int height, int spp, double noise, unsigned seed) {
-  DeviceContext& dc = test::defaultDevice();
-  const Bvh bvh = buildBvh(scene);
-  RenderSettings s = test::renderSettings();
-  s.width = width;
-  s.height = height;
-  s.spp = spp;
-  s.noise = noise;
-  s.seed = seed;
-  return fh::render(dc, scene, bvh, scene.camera, s).film;
-}
-
 // Renders to each target, then checks the film's estimate against the error measured.
 void expectEstimateNearTheTruth(const Scene& scene, int width, int height, int referenceSpp,
                                 std::initializer_list<double> targets) {
+  RenderSettings s = test::renderSettings();
+  s.width = width;
+  s.height = height;
+  s.spp = referenceSpp;
   // The reference with two replicates too (a target it never reaches), for its own error.
-  const Film reference = renderFilm(scene, width, height, referenceSpp, 1e-12, 1000);
+  s.noise = 1e-12;
+  s.seed = 1000;
+  const Film reference = test::render(scene, scene.camera, s).film;
   for (double target : targets) {
     for (unsigned seed : {1u, 2u}) {
-      const Film film = renderFilm(scene, width, height, referenceSpp, target, seed);
+      s.noise = target;
+      s.seed = seed;
+      const Film film = test::render(scene, scene.camera, s).film;
       const double estimate = film.estimatedRelMse();
       EXPECT_LE(estimate, target);
       EXPECT_GE(film.passes(), uint64_t(kNoiseMinPasses));

@@ -37,34 +37,6 @@ using test::SceneBuilder;
 // about 1 in 15000 false failures per comparison.
 constexpr double kZ = 4.0;
 
-struct Rendered {
-  Film film;
-  RenderStats stats;
-};
-
-Rendered render(const Scene& scene, const Camera& camera, Method method, int size, int spp, unsigned seed = 1,
-                size_t wavefront = 0, std::array<float, 3> env = {0, 0, 0}, int maxDepth = 64, bool adaptive = false) {
-  DeviceContext& dc = test::defaultDevice();
-  const Bvh bvh = buildBvh(scene);
-  RenderSettings s = test::renderSettings();
-  s.width = s.height = size;
-  s.spp = spp;
-  s.method = method;
-  s.seed = seed;
-  s.wavefront = wavefront;
-  s.env = env;
-  s.maxDepth = maxDepth;
-  s.adaptive = adaptive;
-  RenderResult r = fh::render(dc, scene, bvh, camera, s);
-  return {r.film, r.stats};
-}
-
-// An adaptive render (render/adaptive.h): spp is its budget, the image's average.
-Rendered renderAdaptive(const Scene& scene, const Camera& camera, Method method, int size, int spp,
-                        size_t wavefront = 0) {
-  return render(scene, camera, method, size, spp, 1, wavefront, {0, 0, 0}, 64, true);
-}
-
 double luminanceMean(const Film& f, size_t p) {
   double m = 0;
   for (int c = 0; c < 3; ++c) m += f.sum[4 * p + size_t(c)];
@@ -134,12 +106,16 @@ Camera insideCamera() {
 }
 
 TEST_P(EveryMethod, ClosedFurnaceBoxIsLeOverOneMinusRho) {
+  RenderSettings s = test::renderSettings();
+  s.method = GetParam();
+  s.width = s.height = 16;
+  s.spp = 256;
   for (const float rho : {0.5f, 0.8f}) {
     SceneBuilder b;
     const float le = 1.f;
     b.closedBoxInside({-1, -1, -1}, {1, 1, 1}, b.material(rho, le));
     const Scene scene = b.build();
-    const Rendered r = render(scene, insideCamera(), GetParam(), 16, 256);
+    const RenderResult r = test::render(scene, insideCamera(), s);
     EXPECT_EQ(r.stats.nonfinite, 0u);
     EXPECT_EQ(r.stats.samples, 16u * 16u * 256u);
     expectMatches(r.film, [&](size_t) { return le / (1.0 - rho); },
@@ -150,7 +126,11 @@ TEST_P(EveryMethod, ClosedFurnaceBoxIsLeOverOneMinusRho) {
 TEST_P(EveryMethod, PlaneUnderRectangularEmitterFollowsLambertsFormula) {
   const Scene scene = PlaneUnderLight::scene();
   const int size = 24;
-  const Rendered r = render(scene, scene.camera, GetParam(), size, 256);
+  RenderSettings s = test::renderSettings();
+  s.method = GetParam();
+  s.width = s.height = size;
+  s.spp = 256;
+  const RenderResult r = test::render(scene, scene.camera, s);
   EXPECT_EQ(r.stats.nonfinite, 0u);
   // The exact pixel values (box filter, 8x8 grid per pixel); pixels whose footprint sees
   // more than one surface are skipped.
@@ -174,7 +154,11 @@ TEST_P(EveryMethod, VertexNormalsAgainstTheWindingShadeLikeFlatFaces) {
       for (int i = 0; i < 3; ++i) scene.cornerNormals.push_back(-n[size_t(i)] / len);
   }
   const int size = 24;
-  const Rendered r = render(scene, scene.camera, GetParam(), size, 256);
+  RenderSettings s = test::renderSettings();
+  s.method = GetParam();
+  s.width = s.height = size;
+  s.spp = 256;
+  const RenderResult r = test::render(scene, scene.camera, s);
   EXPECT_EQ(r.stats.nonfinite, 0u);
   const Image exact = PlaneUnderLight::reference(scene.camera, size, size, 8, true);
   expectMatches(r.film, [&](size_t p) { return double(exact.rgb[3 * p]); },
@@ -190,7 +174,12 @@ TEST_P(EveryMethod, AdaptiveSamplingFollowsLambertsFormulaWithSamplesWhereTheNoi
   Camera camera = scene.camera;
   camera.target = {0.f, 2.6f, -5.f};
   const int size = 32, spp = 256;
-  const Rendered r = renderAdaptive(scene, camera, GetParam(), size, spp);
+  RenderSettings s = test::renderSettings();
+  s.method = GetParam();
+  s.width = s.height = size;
+  s.spp = spp;  // the budget: the image's average (render/adaptive.h)
+  s.adaptive = true;
+  const RenderResult r = test::render(scene, camera, s);
   EXPECT_EQ(r.stats.nonfinite, 0u);
   // 16 x 16 points per pixel: at the plane's far edge, seen at a grazing angle, fewer can
   // miss the few pixels the edge only clips.
@@ -231,8 +220,13 @@ TEST_P(EveryMethod, AdaptiveSamplingFollowsLambertsFormulaWithSamplesWhereTheNoi
 // seed does not depend on how many passes were in flight (the wavefront's size).
 TEST(AdaptiveSampling, TheImageDoesNotDependOnTheWavefront) {
   const Scene scene = loadDefaultScene();
-  const Rendered a = renderAdaptive(scene, scene.camera, Method::MIS, 24, 96);
-  const Rendered b = renderAdaptive(scene, scene.camera, Method::MIS, 24, 96, 64);
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = 24;
+  s.spp = 96;
+  s.adaptive = true;
+  const RenderResult a = test::render(scene, scene.camera, s);
+  s.wavefront = 64;
+  const RenderResult b = test::render(scene, scene.camera, s);
   EXPECT_EQ(a.film.sum, b.film.sum);
   EXPECT_EQ(a.film.passes(), b.film.passes());
   EXPECT_GT(a.film.passes(), 96u) << "later passes cover fewer pixels";
@@ -247,7 +241,13 @@ TEST_P(EveryMethod, PlaneUnderConstantEnvironmentIsRhoTimesEnv) {
   camera.eye = {0, 1, 0};
   camera.target = {0.2f, 0, -1};
   camera.fovYDeg = 40.f;  // sees only the plane
-  const Rendered r = render(scene, camera, GetParam(), 16, 256, 3, 0, {env, env, env});
+  RenderSettings s = test::renderSettings();
+  s.method = GetParam();
+  s.width = s.height = 16;
+  s.spp = 256;
+  s.seed = 3;
+  s.env = {env, env, env};
+  const RenderResult r = test::render(scene, camera, s);
   expectMatches(r.film, [&](size_t) { return rho * env; }, methodName(GetParam()));
 }
 
@@ -290,7 +290,7 @@ double imageVariance(const Film& f) {
 }
 
 struct ThreeMethods {
-  Rendered pt, nee, mis;
+  RenderResult pt, nee, mis;
 };
 
 // pt, nee and mis of one scene, with independent seeds or, with `commonSeed`, one seed for
@@ -298,10 +298,15 @@ struct ThreeMethods {
 // method, so the three then trace the same BSDF-sampled paths (common random numbers).
 // Checks every sample is finite.
 ThreeMethods renderAllMethods(const Scene& scene, const Camera& camera, int size, int spp, bool commonSeed = false) {
-  const unsigned seed = commonSeed ? 21 : 11;
-  ThreeMethods r{render(scene, camera, Method::PT, size, spp, seed),
-                 render(scene, camera, Method::NEE, size, spp, commonSeed ? seed : 12),
-                 render(scene, camera, Method::MIS, size, spp, commonSeed ? seed : 13)};
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = size;
+  s.spp = spp;
+  const auto renderWith = [&](Method method, unsigned seed) {
+    s.method = method;
+    s.seed = commonSeed ? 21 : seed;
+    return test::render(scene, camera, s);
+  };
+  ThreeMethods r{renderWith(Method::PT, 11), renderWith(Method::NEE, 12), renderWith(Method::MIS, 13)};
   EXPECT_EQ(r.pt.stats.nonfinite, 0u) << "pt";
   EXPECT_EQ(r.nee.stats.nonfinite, 0u) << "nee";
   EXPECT_EQ(r.mis.stats.nonfinite, 0u) << "mis";
@@ -388,9 +393,17 @@ TEST(PathTracer, EveryStrategyRendersTheSameBits) {
 
 TEST(PathTracer, DeterministicForASeedWhateverTheWavefront) {
   const Scene scene = loadDefaultScene();
-  const Rendered a = render(scene, scene.camera, Method::MIS, 16, 8, 5, 256);
-  const Rendered b = render(scene, scene.camera, Method::MIS, 16, 8, 5, 1024);
-  const Rendered c = render(scene, scene.camera, Method::MIS, 16, 8, 6, 256);
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = 16;
+  s.spp = 8;
+  s.seed = 5;
+  s.wavefront = 256;
+  const RenderResult a = test::render(scene, scene.camera, s);
+  s.wavefront = 1024;
+  const RenderResult b = test::render(scene, scene.camera, s);
+  s.seed = 6;
+  s.wavefront = 256;
+  const RenderResult c = test::render(scene, scene.camera, s);
   EXPECT_EQ(a.film.sum, b.film.sum);
   EXPECT_EQ(a.film.sumSq, b.film.sumSq);
   EXPECT_NE(a.film.sum, c.film.sum);
@@ -465,9 +478,13 @@ TEST(PathTracer, NoNonFiniteSamplesOnAnyCorpusScene) {
         "cornell-box/CornellBox-Glossy.obj", "veach/veach-plates.obj", "mori-knob/testObj.obj",
         "colonnade/colonnade.obj"}) {
     const Scene scene = loadScene(test::testScene(path));
+    RenderSettings s = test::renderSettings();
+    s.width = s.height = 16;
+    s.spp = 4;
+    s.env = {1.f, 1.f, 1.f};  // scenes without lights (the colonnade, the archive's Glossy)
     for (Method m : {Method::PT, Method::NEE, Method::MIS}) {
-      // Scenes without lights (the colonnade, the archive's Glossy) under a constant environment.
-      const Rendered r = render(scene, scene.camera, m, 16, 4, 1, 0, {1.f, 1.f, 1.f});
+      s.method = m;
+      const RenderResult r = test::render(scene, scene.camera, s);
       EXPECT_EQ(r.stats.nonfinite, 0u) << path << " " << methodName(m);
       for (float v : r.film.image().rgb) ASSERT_TRUE(std::isfinite(v)) << path;
     }
@@ -521,7 +538,10 @@ TEST(PixelFilters, ImportanceSamplesFollowEachFiltersShape) {
 
 TEST(PathTracer, StatsCountRaysAndSamples) {
   const Scene scene = loadDefaultScene();
-  const Rendered r = render(scene, scene.camera, Method::MIS, 16, 4);
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = 16;
+  s.spp = 4;
+  const RenderResult r = test::render(scene, scene.camera, s);
   EXPECT_EQ(r.stats.samples, 16u * 16u * 4u);
   EXPECT_EQ(r.stats.cameraRays, r.stats.samples);
   EXPECT_GT(r.stats.bounceRays, 0u);
@@ -553,8 +573,12 @@ TEST(WhereMethodsFail, ExtremeScalesAndFarFromTheOrigin) {
     Camera c = insideCamera();
     c.eye = c.eye * scale + offset;
     c.target = c.target * scale + offset;
+    RenderSettings s = test::renderSettings();
+    s.width = s.height = 16;
+    s.spp = 128;
     for (Method m : {Method::PT, Method::NEE, Method::MIS}) {
-      const Rendered r = render(scene, c, m, 16, 128);
+      s.method = m;
+      const RenderResult r = test::render(scene, c, s);
       EXPECT_EQ(r.stats.nonfinite, 0u);
       expectMatches(r.film, [](size_t) { return 2.0; },
                     std::string(methodName(m)) + " at scale " + std::to_string(scale) + " offset " +
@@ -567,8 +591,13 @@ TEST(WhereMethodsFail, AlbedoNearOneRouletteStaysUnbiasedAndEnds) {
   // rho = 0.95: L = Le / (1 - rho) = 20, paths of ~20 bounces; the depth limit is raised so
   // only Russian roulette ends them (0.95^1001 is far below the noise).
   const Scene scene = furnaceAt(0.95f, 1.f, 1.f, {0, 0, 0});
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = 16;
+  s.spp = 256;
+  s.maxDepth = 1000;
   for (Method m : {Method::PT, Method::MIS}) {
-    const Rendered r = render(scene, insideCamera(), m, 16, 256, 1, 0, {0, 0, 0}, 1000);
+    s.method = m;
+    const RenderResult r = test::render(scene, insideCamera(), s);
     EXPECT_EQ(r.stats.nonfinite, 0u);
     expectMatches(r.film, [](size_t) { return 20.0; }, methodName(m));
   }
@@ -583,8 +612,12 @@ TEST(WhereMethodsFail, DegenerateTrianglesAndZeroAreaEmittersChangeNothing) {
   b.quad({-0.3f, 0.f, 0.f}, {0.3f, 0.f, 0.f}, {0.6f, 0.f, 0.f}, {0.9f, 0.f, 0.f}, bright);  // collinear
   const Scene scene = b.build();
   EXPECT_EQ(scene.lights.size(), 12u);  // the zero-area emitters are left out of the light list
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = 16;
+  s.spp = 128;
   for (Method m : {Method::PT, Method::NEE, Method::MIS}) {
-    const Rendered r = render(scene, insideCamera(), m, 16, 128);
+    s.method = m;
+    const RenderResult r = test::render(scene, insideCamera(), s);
     EXPECT_EQ(r.stats.nonfinite, 0u);
     expectMatches(r.film, [](size_t) { return 2.0; }, methodName(m));
   }
@@ -593,8 +626,12 @@ TEST(WhereMethodsFail, DegenerateTrianglesAndZeroAreaEmittersChangeNothing) {
 TEST(WhereMethodsFail, NoLightsIsBlackAndCameraInsideAnObjectIsFinite) {
   SceneBuilder dark;
   dark.closedBoxInside({-1, -1, -1}, {1, 1, 1}, dark.material(0.8f));
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = 8;
+  s.spp = 8;
   for (Method m : {Method::PT, Method::NEE, Method::MIS}) {
-    const Rendered r = render(dark.build(), insideCamera(), m, 8, 8);
+    s.method = m;
+    const RenderResult r = test::render(dark.build(), insideCamera(), s);
     for (float v : r.film.sum) EXPECT_EQ(v == 0.f || v == 8.f, true);  // radiance 0, counts 8
   }
   // The camera inside a closed box whose faces point outward: it sees only back faces.
@@ -606,8 +643,10 @@ TEST(WhereMethodsFail, NoLightsIsBlackAndCameraInsideAnObjectIsFinite) {
   inverted.quadFacing({1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}, {5, 0, 0}, m);
   inverted.quadFacing({-1, -1, -1}, {-1, 1, -1}, {1, 1, -1}, {1, -1, -1}, {0, 0, -5}, m);
   inverted.quadFacing({-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}, {0, 0, 5}, m);
+  s.spp = 16;
   for (Method method : {Method::PT, Method::NEE, Method::MIS}) {
-    const Rendered r = render(inverted.build(), insideCamera(), method, 8, 16);
+    s.method = method;
+    const RenderResult r = test::render(inverted.build(), insideCamera(), s);
     EXPECT_EQ(r.stats.nonfinite, 0u);
     // Emission leaves the fronts only (outward): inside, nothing is lit.
     for (float v : r.film.image().rgb) EXPECT_EQ(v, 0.f);
@@ -628,10 +667,19 @@ TEST(WhereMethodsFail, TinyBrightLight) {
   camera.target = {0.f, 0.f, 0.f};
   camera.fovYDeg = 50.f;
   const int size = 16;
-  const Rendered pt = render(scene, camera, Method::PT, size, 256, 21);
-  const Rendered nee = render(scene, camera, Method::NEE, size, 256, 22);
-  const Rendered mis = render(scene, camera, Method::MIS, size, 256, 23);
-  for (const Rendered* r : {&pt, &nee, &mis}) EXPECT_EQ(r->stats.nonfinite, 0u);
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = size;
+  s.spp = 256;
+  s.method = Method::PT;
+  s.seed = 21;
+  const RenderResult pt = test::render(scene, camera, s);
+  s.method = Method::NEE;
+  s.seed = 22;
+  const RenderResult nee = test::render(scene, camera, s);
+  s.method = Method::MIS;
+  s.seed = 23;
+  const RenderResult mis = test::render(scene, camera, s);
+  for (const RenderResult* r : {&pt, &nee, &mis}) EXPECT_EQ(r->stats.nonfinite, 0u);
   // nee and mis converge to Lambert's value on the plane (the light itself is too small
   // to cover a pixel, and pixels that see it or the plane's edge are skipped).
   const CameraFrame f = makeCameraFrame(camera, size, size);
@@ -678,7 +726,7 @@ TEST(WhereMethodsFail, CausticsThroughGlass) {
   const float half = 0.15f, h = 3.34f, le = 40.f;  // the light, as scenes/failure/make_scenes.py writes it
   const std::vector<float3> light = {{-half, h, -half}, {half, h, -half}, {half, h, half}, {-half, h, half}};
   const double bareFloor = 0.7 / M_PI * lambertIrradiance({0, 0, 0}, {0, 1, 0}, light, le);
-  for (const Rendered* m : {&r.pt, &r.nee, &r.mis}) {
+  for (const RenderResult* m : {&r.pt, &r.nee, &r.mis}) {
     double brightest = 0;
     for (int by = 0; by < size / 4; ++by)
       for (int bx = 0; bx < size / 4; ++bx) {
@@ -723,8 +771,13 @@ TEST(WhereMethodsFail, GrazingAngles) {
   camera.fovYDeg = 2.f;  // the view spans the plane from 1.4 units ahead to its far edge
   const int size = 24;
   const Image exact = PlaneUnderLight::reference(camera, size, size, 8, true);
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = size;
+  s.spp = 256;
+  s.seed = 7;
   for (Method m : {Method::PT, Method::NEE, Method::MIS}) {
-    const Rendered r = render(scene, camera, m, size, 256, 7);
+    s.method = m;
+    const RenderResult r = test::render(scene, camera, s);
     EXPECT_EQ(r.stats.nonfinite, 0u);
     expectMatches(r.film, [&](size_t p) { return double(exact.rgb[3 * p]); }, methodName(m));
   }

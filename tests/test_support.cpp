@@ -1,4 +1,4 @@
-// Test helpers.
+// The helpers shared by the tests (test_support.h).
 #include "test_support.h"
 
 #include <sys/wait.h>
@@ -11,6 +11,8 @@
 #include <fstream>
 #include <vector>
 
+#include "accel/bvh.h"
+#include "base/test_hooks.h"
 #include "cli/flags.h"
 #include "device/devices.h"
 #include "image/image_io.h"
@@ -24,9 +26,15 @@ DeviceContext& defaultDevice() {
 
 RenderSettings renderSettings() {
   RenderSettings s;
-  if (const char* strategy = std::getenv("FREDHOLM_TEST_STRATEGY")) s.strategy = parseStrategy(strategy);
+  if (const std::string& strategy = testHooks().testStrategy; !strategy.empty()) s.strategy = parseStrategy(strategy);
   return s;
 }
+
+RenderResult render(const Scene& scene, const Camera& camera, const RenderSettings& settings) {
+  const Bvh bvh = buildBvh(scene);
+  return fh::render(defaultDevice(), scene, bvh, camera, settings);
+}
+
 namespace fs = std::filesystem;
 
 std::string generatedScene(const std::string& relative) {

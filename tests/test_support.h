@@ -1,4 +1,6 @@
-// Helpers shared by the tests: paths, temporary directories, running the CLI.
+// Helpers shared by the tests (one library, fredholm_test_support, linked by every test
+// executable): the device, render settings and renders, paths, temporary directories,
+// running the CLI, brute-force ray oracles.
 #pragma once
 #include <cmath>
 #include <string>
@@ -6,7 +8,10 @@
 #include <nlohmann/json.hpp>
 
 #include "device/device_context.h"
+#include "render/render.h"
 #include "render/settings.h"
+#include "scene/camera.h"
+#include "scene/scene.h"
 
 namespace fh::test {
 
@@ -15,8 +20,16 @@ namespace fh::test {
 DeviceContext& defaultDevice();
 
 // RenderSettings{} with the strategy this run tests: FREDHOLM_TEST_STRATEGY (CTest runs the
-// rendering suites under several, tests/CMakeLists.txt), else auto.
+// rendering suites under several, tests/CMakeLists.txt; base/test_hooks.h), else auto.
 RenderSettings renderSettings();
+
+// `scene` seen by `camera`, rendered on defaultDevice() (its BVH built here). The one render
+// call the rendering suites share; what differs goes in the settings, by name:
+//   RenderSettings s = test::renderSettings();
+//   s.method = Method::PT;
+//   s.spp = 256;
+//   const RenderResult r = test::render(scene, camera, s);
+RenderResult render(const Scene& scene, const Camera& camera, const RenderSettings& settings);
 
 // Absolute path of a file in this repository's scenes/.
 std::string projectScene(const std::string& relative);
@@ -47,8 +60,6 @@ CommandResult runFredholm(const std::string& args, const std::string& env = "");
 std::string writeFeatureScene(const std::string& dir);
 
 }  // namespace fh::test
-
-#include "scene/scene.h"
 
 namespace fh::test {
 
