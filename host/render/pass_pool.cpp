@@ -31,10 +31,11 @@ PassPool::PassPool(const RenderSettings& s, const RenderLinks& links, int worker
     : settings_(s),
       links_(links),
       total_(passLimit(s)),
-      start_(std::chrono::steady_clock::now()),
+      film_(links.resume ? *links.resume : Film(s.width, s.height, s.surfaceAovs, s.replicates() == 2, s.firstPass)),
+      stop_(s, links.resume.get()),
+      rounds_(s, total_, film_),
       outstanding_(size_t(workers)),
       done_(size_t(workers), 0),
-      film_(links.resume ? *links.resume : Film(s.width, s.height, s.surfaceAovs, s.replicates() == 2, s.firstPass)),
       progress_(s.progress),
       lastCheckpoint_(std::chrono::steady_clock::now()) {
   // A resumed render goes on from the first pass its film lacks; a chunk starts at its first.
@@ -42,30 +43,6 @@ PassPool::PassPool(const RenderSettings& s, const RenderLinks& links, int worker
   mergedSamples_ = resumedSamples_ = film_.samples();
   samplesDone_.assign(size_t(workers), 0);
   clocks_.resize(size_t(workers));
-  if (!s.adaptive) {
-    addRound(0, nullptr);
-  } else {
-    sampleBudget_ = uint64_t(std::max(1, s.spp)) * film_.pixels();
-    samplesHanded_ = uint64_t(mergedSamples_);
-    // The round the film goes on with and, past its choice point, the one after it, both
-    // chosen before the film got here (the first covers every pixel): a film saved in a
-    // later round lists them.
-    const uint32_t begin = adaptiveRoundBegin(next_), end = adaptiveRoundEnd(begin);
-    const auto missing = [&](const char* which) {
-      return Error("--resume: the film ends in an adaptive round (at pass " + std::to_string(next_) +
-                   ") and does not say which pixels " + which + " covers");
-    };
-    if (begin > 0 && !film_.roundPixels) throw missing("it");
-    addRound(begin, begin > 0 ? film_.roundPixels : nullptr);
-    if (next_ < adaptiveChoicePoint(begin)) {  // the merger chooses it
-    } else if (film_.nextRoundPixels) addRound(end, film_.nextRoundPixels);
-    else if (next_ == adaptiveChoicePoint(begin)) addRound(end, pixelsOfRoundAfter(begin));
-    else throw missing("the round after it");
-    recordRounds();
-  }
-  // ... unless it met its noise target already (a render that stopped there).
-  noiseReached_ = links.resume && s.noise > 0.0 && film_.passes() >= kNoiseMinPasses &&
-                  film_.estimatedRelMse() <= s.noise;
   killAfter_ = testHooks().killAfterPasses;
   merger_ = std::thread([this] { mergeInOrder(); });
 }
@@ -81,8 +58,6 @@ void PassPool::stopMerging() {
   if (merger_.joinable()) merger_.join();
 }
 
-bool PassPool::outOfTime() const { return settings_.seconds > 0.0 && secondsSince(start_) >= settings_.seconds; }
-
 // The next pass for `worker`. With a time budget, no new pass starts once it is spent;
 // those started finish, so every pixel ends with the same sample count. When none is left
 // but other workers still have passes in flight, a worker with none of its own waits: if
@@ -90,10 +65,7 @@ bool PassPool::outOfTime() const { return settings_.seconds > 0.0 && secondsSinc
 // worker with passes of its own never waits; it asks again after its next batch.)
 bool PassPool::take(int worker, Pass& pass) {
   std::unique_lock<std::mutex> lock(mutex_);
-  if (!started_) {  // the time budget counts from the first pass handed out
-    start_ = std::chrono::steady_clock::now();
-    started_ = true;
-  }
+  stop_.start();
   for (;;) {
     if (links_.stopRequested()) return false;
     if (!requeued_.empty()) {
@@ -101,14 +73,14 @@ bool PassPool::take(int worker, Pass& pass) {
       requeued_.pop_front();
       break;
     }
-    if (noiseReached_) return false;
+    if (stop_.noiseReached()) return false;
     const NewPass next = mergerBehind() ? NewPass::Later : nextNewPass(pass.index);
     if (next == NewPass::Given) break;
     const bool mine = !outstanding_[size_t(worker)].empty();
     if (mine || (next == NewPass::None && !anyOutstanding())) return false;
     changed_.wait(lock);
   }
-  pass.pixels = roundOf(pass.index)->pixels;
+  pass.pixels = rounds_.roundOf(pass.index)->pixels;
   outstanding_[size_t(worker)].insert(pass.index);
   return true;
 }
@@ -135,13 +107,10 @@ PassPool::NewPass PassPool::nextNewPass(uint32_t& pass) {
   }
   // However short the time budget, a render renders one pass: an image of nothing would
   // answer no one's question.
-  if (next_ >= total_ || (next_ > firstNew_ && outOfTime())) return NewPass::None;
-  const Round* round = roundOf(next_);
+  if (next_ >= total_ || (next_ > firstNew_ && stop_.outOfTime())) return NewPass::None;
+  const PassRounds::Round* round = rounds_.roundOf(next_);
   if (!round) return NewPass::Later;
-  if (settings_.adaptive) {
-    if (samplesHanded_ + round->size > sampleBudget_) return NewPass::None;
-    samplesHanded_ += round->size;
-  }
+  if (!rounds_.takeFromBudget(*round)) return NewPass::None;
   pass = next_++;
   return NewPass::Given;
 }
@@ -151,7 +120,7 @@ void PassPool::done(int worker, uint32_t pass, std::vector<float>& samples) {
   std::lock_guard<std::mutex> lock(mutex_);
   outstanding_[size_t(worker)].erase(pass);
   ++done_[size_t(worker)];
-  samplesDone_[size_t(worker)] += roundOf(pass)->size;
+  samplesDone_[size_t(worker)] += rounds_.roundOf(pass)->size;
   WorkerClock& clock = clocks_[size_t(worker)];
   clock.last = std::chrono::steady_clock::now();
   if (done_[size_t(worker)] == 1) {
@@ -200,90 +169,18 @@ Film PassPool::finish(bool& complete) {
   stopMerging();
   std::lock_guard<std::mutex> lock(mutex_);
   checkpoint(true);
-  complete = noiseReached_ || (pending_.empty() && requeued_.empty() && !anyOutstanding());
+  complete = stop_.noiseReached() || (pending_.empty() && requeued_.empty() && !anyOutstanding());
   for (auto& [pass, samples] : pending_) {
-    if (noiseReached_) break;  // beyond the pass that met the target
-    const Round& round = *roundOf(pass);
+    if (stop_.noiseReached()) break;  // beyond the pass that met the target
+    const PassRounds::Round& round = *rounds_.roundOf(pass);
     film_.addPass(pass, samples, round.list());
     mergedSamples_ += double(round.size);
   }
   pending_.clear();
   spare_.clear();  // a frame of samples each
   if (links_.ledger) progress_.end();  // other processes may still be rendering
-  else progress_.finish(uint64_t(mergedSamples_ - resumedSamples_), secondsSince(start_), steadyRate(), firstPassSeconds());
+  else progress_.finish(uint64_t(mergedSamples_ - resumedSamples_), stop_.elapsed(), steadyRate(), firstPassSeconds());
   return std::move(film_);  // not a copy of its sums (64 bytes a pixel): the pool is done with it
-}
-
-// The round from pass `begin` on covers `pixels` (null, or every pixel listed: every pixel).
-void PassPool::addRound(uint32_t begin, std::shared_ptr<const PixelList> pixels) {
-  if (pixels && pixels->size() == film_.pixels()) pixels = nullptr;
-  const size_t size = pixels ? pixels->size() : film_.pixels();
-  std::shared_ptr<const RoundPixels> round;
-  if (settings_.adaptive) {
-    std::vector<uint32_t> offsets = sequenceOffsets(begin, pixels.get());
-    if (pixels || std::any_of(offsets.begin(), offsets.end(), [](uint32_t o) { return o != 0; }))
-      round = std::make_shared<const RoundPixels>(
-          RoundPixels{pixels ? *pixels : everyPixel(film_.pixels()), std::move(offsets)});
-  }
-  rounds_.push_back({begin, settings_.adaptive ? adaptiveRoundEnd(begin) : total_, std::move(round), size});
-}
-
-// Where each pixel listed (null: every pixel) is in its sequence when the round from pass
-// `begin` on starts: its sample count then, less `begin`. The film holds the passes before
-// its nextPass(); the rounds known between it and `begin` add theirs, and a round the film
-// is already into (a resumed render's) takes its own off. The counts are whole rounds'
-// lengths, which are even, so a point's parity is its pass's (kernels/sampler.h).
-std::vector<uint32_t> PassPool::sequenceOffsets(uint32_t begin, const PixelList* pixels) const {
-  std::vector<double> counts(film_.pixels());
-  for (size_t p = 0; p < counts.size(); ++p) counts[p] = film_.count(p);
-  const auto add = [&](const PixelList* list, double passes) {
-    if (!list)
-      for (double& c : counts) c += passes;
-    else
-      for (uint32_t p : *list) counts[p] += passes;
-  };
-  const uint32_t held = uint32_t(film_.nextPass());
-  if (held > begin) add(pixels, -double(held - begin));
-  for (const Round& r : rounds_) {
-    const uint32_t from = std::max(r.begin, held), to = std::min(r.end, begin);
-    if (from < to) add(r.list(), double(to - from));
-  }
-  std::vector<uint32_t> offsets;
-  const auto offset = [&](uint32_t p) { offsets.push_back(uint32_t(counts[p]) - begin); };
-  if (!pixels)
-    for (uint32_t p = 0; p < counts.size(); ++p) offset(p);
-  else
-    for (uint32_t p : *pixels) offset(p);
-  return offsets;
-}
-
-const PassPool::Round* PassPool::roundOf(uint32_t pass) const {
-  for (const Round& r : rounds_)
-    if (pass >= r.begin && pass < r.end) return &r;
-  return nullptr;
-}
-
-// The pixels of the round after the one from pass `begin` on, chosen from the film, which
-// holds every pass before that round's choice point (the film is the merger's alone, as is
-// adding rounds).
-std::shared_ptr<const PixelList> PassPool::pixelsOfRoundAfter(uint32_t begin) const {
-  const Round& round = *roundOf(begin);
-  return adaptivePixels(film_, round.end, round.list(), round.end - adaptiveChoicePoint(begin));
-}
-
-// What a checkpoint of the film needs to go on: the pixels of the round its next pass is
-// in and, once chosen, of the round after it (every pixel listed, where they cover every
-// pixel); none in the first round.
-void PassPool::recordRounds() {
-  const auto listed = [&](const Round* r) -> std::shared_ptr<const PixelList> {
-    if (!r || r->begin < kAdaptiveFirstRound) return nullptr;
-    if (r->pixels) return std::shared_ptr<const PixelList>(r->pixels, &r->pixels->pixels);
-    if (!everyPixel_) everyPixel_ = std::make_shared<const PixelList>(everyPixel(film_.pixels()));
-    return everyPixel_;
-  };
-  const Round* current = roundOf(nextToMerge_);
-  film_.roundPixels = listed(current);
-  film_.nextRoundPixels = film_.roundPixels ? listed(roundOf(current->end)) : nullptr;
 }
 
 bool PassPool::anyOutstanding() const {
@@ -307,35 +204,28 @@ void PassPool::mergeInOrder() {
     samples.swap(next->second);
     const uint32_t pass = next->first;
     pending_.erase(next);
-    const Round round = *roundOf(pass);  // the merger alone adds and drops rounds
+    const PassRounds::Round round = *rounds_.roundOf(pass);  // the merger alone adds and drops rounds
     lock.unlock();
     film_.addPass(pass, samples, round.list());
     if (links_.watcher && links_.watcher->wantsFrame()) links_.watcher->show(film_);
-    const bool check = settings_.noise > 0.0 && film_.passes() >= kNoiseMinPasses;
+    const bool check = stop_.checksNoise(film_);
     const double estimate = check ? film_.estimatedRelMse() : -1.0;
     if (links_.ledger) links_.ledger->finished(pass);
     // At an adaptive round's choice point, the round after it is chosen.
-    const bool chooses = settings_.adaptive && pass + 1 == adaptiveChoicePoint(round.begin);
-    auto following = chooses ? pixelsOfRoundAfter(round.begin) : nullptr;
+    auto following = rounds_.choosesAfter(pass, round) ? rounds_.pixelsOfRoundAfter(round.begin) : nullptr;
     lock.lock();
     // One spare a worker at most: passes that piled up for the merger (up to its budget,
     // mergerBehind) leave no frames behind them.
     if (spare_.size() < done_.size()) spare_.push_back(std::move(samples));
     ++nextToMerge_;
     mergedSamples_ += double(round.size);
-    const bool ends = settings_.adaptive && pass + 1 == round.end;
-    if (ends) rounds_.pop_front();
-    if (chooses) addRound(round.end, std::move(following));
-    if (chooses || ends) {
-      recordRounds();
-      changed_.notify_all();  // workers may wait for the round
-    }
-    changed_.notify_all();  // workers may wait for the merger to catch up
+    // Workers may wait for a new round, or for the merger to catch up.
+    rounds_.merged(pass, round, std::move(following), nextToMerge_);
+    changed_.notify_all();
     checkpoint(false);
-    if (check) noiseEstimate_ = estimate;
+    const bool met = check && stop_.meets(estimate);
     showProgress();
-    if (check && estimate <= settings_.noise) {
-      noiseReached_ = true;  // no more passes start, and none after this one is merged
+    if (met) {  // no more passes start, and none after this one is merged
       changed_.notify_all();
       return;
     }
@@ -377,25 +267,22 @@ double PassPool::firstPassSeconds() const {
   double first = 0.0;
   for (size_t w = 0; w < clocks_.size(); ++w) {
     if (done_[w] == 0) continue;
-    const double seconds = std::chrono::duration<double>(clocks_[w].first - start_).count();
+    const double seconds = std::chrono::duration<double>(clocks_[w].first - stop_.startTime()).count();
     first = first > 0.0 ? std::min(first, seconds) : seconds;
   }
   return first;
 }
 
 void PassPool::showProgress() {
-  const double elapsed = secondsSince(start_);
-  const bool timed = settings_.seconds > 0.0, noisy = settings_.noise > 0.0;
-  // relMSE falls as 1 / samples, so target / estimate is the share of samples taken.
-  const double noiseShare = noiseEstimate_ > 0.0 ? std::min(1.0, settings_.noise / noiseEstimate_) : 0.0;
   // This run's work only: a chunk's passes, or those a resumed render adds to its checkpoint.
   const uint64_t passes = total_ - std::min(total_, firstNew_);
   const uint64_t elsewhere = links_.ledger ? links_.ledger->finishedElsewhere() : 0;
-  const uint64_t samples = settings_.adaptive ? sampleBudget_ - uint64_t(resumedSamples_) : passes * film_.pixels();
-  progress_.update(uint64_t(mergedSamples_ - resumedSamples_) + elsewhere * film_.pixels(), timed || noisy ? 0 : samples, elapsed,
-                   noisy ? std::min(1.0, std::max(noiseShare, timed ? elapsed / settings_.seconds : 0.0))
-                         : timed ? std::min(1.0, elapsed / settings_.seconds) : 0.0,
-                   steadyRate());
+  const uint64_t samples =
+      settings_.adaptive ? rounds_.sampleBudget() - uint64_t(resumedSamples_) : passes * film_.pixels();
+  // With a budget of time or noise, the share done is the budget's, not the samples'.
+  const bool budgeted = stop_.timed() || stop_.noisy();
+  progress_.update(uint64_t(mergedSamples_ - resumedSamples_) + elsewhere * film_.pixels(), budgeted ? 0 : samples,
+                   stop_.elapsed(), stop_.share(), steadyRate());
 }
 
 }  // namespace fh

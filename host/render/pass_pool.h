@@ -7,8 +7,10 @@
 // first pass count whose film meets it: passes finished beyond it are dropped, and the image
 // for a seed and target is the same whichever devices rendered and however fast.
 //
-// An adaptive render's passes come in rounds (render/adaptive.h): the merger chooses a
-// round's pixels once the film holds every pass before the round before it, and workers
+// The pool schedules; two parts decide with it. StopRules (render/stop_rules.h): the time
+// budget and the noise target. PassRounds (render/pass_rounds.h): which pixels each pass
+// covers. An adaptive render's passes come in rounds (render/adaptive.h): the merger chooses
+// a round's pixels once the film holds every pass before the round before it, and workers
 // wait for them only if they get that far ahead. Its sample count is a budget: spp times
 // the pixels, over whichever pixels the rounds cover.
 #pragma once
@@ -25,9 +27,11 @@
 
 #include "render/film.h"
 #include "render/pass_ledger.h"
+#include "render/pass_rounds.h"
 #include "render/pass_source.h"
 #include "render/progress.h"
 #include "render/settings.h"
+#include "render/stop_rules.h"
 
 namespace fh {
 
@@ -60,19 +64,6 @@ class PassPool : public PassSource {
   enum class NewPass { Given, Later, None };  // Later: once the merger chooses the next round
   NewPass nextNewPass(uint32_t& pass);
   bool mergerBehind() const;  // under the lock
-  // Runs of passes over the same pixels: every pass of a render but an adaptive one's in one.
-  struct Round {
-    uint32_t begin = 0, end = 0;
-    std::shared_ptr<const RoundPixels> pixels;  // null: every pixel, from its pass's point on
-    size_t size = 0;                            // pixels covered
-    const PixelList* list() const { return pixels ? &pixels->pixels : nullptr; }  // null: every pixel
-  };
-  void addRound(uint32_t begin, std::shared_ptr<const PixelList> pixels);
-  std::vector<uint32_t> sequenceOffsets(uint32_t begin, const PixelList* pixels) const;
-  const Round* roundOf(uint32_t pass) const;  // null: its pixels are not chosen yet
-  std::shared_ptr<const PixelList> pixelsOfRoundAfter(uint32_t begin) const;
-  void recordRounds();
-  bool outOfTime() const;
   double steadyRate() const;        // under the lock
   double firstPassSeconds() const;  // under the lock
   void mergeInOrder();
@@ -85,16 +76,15 @@ class PassPool : public PassSource {
   const RenderSettings settings_;
   const RenderLinks links_;
   const uint32_t total_;
-  std::chrono::steady_clock::time_point start_;  // when the first pass was handed out
-  bool started_ = false;
+  // Every member below is guarded by mutex_; the film and the rounds' choices are the
+  // merger's, which works on them outside the lock.
+  Film film_;
+  StopRules stop_;     // time budget, noise target
+  PassRounds rounds_;  // which pixels each pass covers
   uint32_t next_ = 0, nextToMerge_ = 0;
   uint32_t firstNew_ = 0;  // the first pass this render hands out (a time budget allows it always)
   double mergedSamples_ = 0;  // in the film
   double resumedSamples_ = 0;  // in the film a resumed render started from: not this run's work
-  // The rounds whose pixels are known, in order, from the one being merged on.
-  std::deque<Round> rounds_;
-  std::shared_ptr<const PixelList> everyPixel_;  // a checkpoint's list for rounds of every pixel
-  uint64_t sampleBudget_ = 0, samplesHanded_ = 0;  // an adaptive render's
   std::vector<uint64_t> samplesDone_;
   // Per worker: when its first and latest passes finished, and its samples at the first. The
   // first pass carries the kernels' build (PoCL compiles at the first launch): rates count
@@ -109,15 +99,12 @@ class PassPool : public PassSource {
   std::vector<uint64_t> done_;
   std::map<uint32_t, std::vector<float>> pending_;  // finished, not yet merged
   std::vector<std::vector<float>> spare_;           // merged passes' buffers, for reuse
-  Film film_;                                       // the merger's alone until finish()
   Progress progress_;
   bool stopping_ = false;
   std::chrono::steady_clock::time_point lastCheckpoint_;
   std::vector<std::string> warnings_;
   long killAfter_ = -1;  // FREDHOLM_KILL_AFTER_PASSES (tests): SIGKILL once that many are saved
-  bool noiseReached_ = false;
   bool ledgerDry_ = false;  // the ledger said no more
-  double noiseEstimate_ = -1.0;  // the film's at the last check of a noise target
   std::thread merger_;
 };
 
