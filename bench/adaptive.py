@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Adaptive against uniform sampling (issue 16): renders a scene with and without
+"""Adaptive against uniform sampling: renders a scene with and without
 --adaptive at a series of sample budgets, alternating the two, measures each image's relMSE
 against a long uniform reference, and writes a CSV and a log-log chart of relMSE against
 render seconds. Prints, for a target relMSE, the seconds each takes to reach it (log-log

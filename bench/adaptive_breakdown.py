@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Where adaptive sampling's error goes, and what the best allocation could gain (issue 16).
+"""Where adaptive sampling's error goes, and what the best allocation could gain.
 
 Renders a scene uniformly and with --adaptive at one sample budget (seeds alternating),
 measures each pixel's relative squared error against a long uniform reference, and groups

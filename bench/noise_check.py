@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Checks --noise's error estimate against the truth (issue 16).
+"""Checks --noise's error estimate against the truth.
 
 For each scene: a long reference (two replicates too, so its own estimated relMSE is known
 and taken off), then renders stopped by --noise at each target with two seeds; prints the

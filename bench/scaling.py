@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""How ray casting grows with the scene (issue 14): fredholm and Embree on the same rays.
+"""How ray casting grows with the scene: fredholm and Embree on the same rays.
 
 Runs `fredholm bench spheres:N` for N from 1e2 to 1e7 (generated scenes: a floor under a
 grid of bumped spheres), one process per size so each starts clean, and charts Mrays/s per

@@ -7,7 +7,7 @@ only interleaved figures compare).
                           [--fredholm build/fredholm] [--scenes default] [--current-flags F]
                           -- render flags...
 
-Scenes are the issue 13 set by default (the bunny-in-box, Sponza under a white sky, the
+Scenes are the CPU-speed set by default (the bunny-in-box, Sponza under a white sky, the
 water box and Veach's scene, from ../shared/scenes) or --scenes PATH[,PATH...]. Every
 scene is rendered once by each runner as a warm-up (kernel compilation), then --rounds
 times with the runners' order rotated each round. Prints samples/s (--stats) per round,
@@ -35,7 +35,7 @@ def main():
     ap.add_argument("--strategies", default="simd8,megakernel8")
     benchlib.add_arguments(ap, "--binary")
     ap.add_argument("--baseline", help="an older fredholm binary (run without --strategy), listed first")
-    ap.add_argument("--scenes", help="comma-separated scene paths (default: the issue 13 set)")
+    ap.add_argument("--scenes", help="comma-separated scene paths (default: the CPU-speed set)")
     ap.add_argument("--current-flags", default="",
                     help="render flags for the current binary only (e.g. '--rr-depth 3': the baseline's roulette)")
     opts, flags = benchlib.parse_with_rest(ap)

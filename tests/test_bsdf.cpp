@@ -481,7 +481,7 @@ TEST(WhiteFurnace, LosslessObjectsVanishInAUniformEnclosure) {
 // texture_lookup against the analytic bilinear interpolation of a periodic ramp: texel
 // column x holds red = f(x), row y green = f(y), so between texel centres red and green are
 // linear in u and v, and across the seam at u, v = 0 and 1 they wrap from the last texel to
-// the first. A nearest-texel lookup (issue 17: it passed the test below, which reads texels
+// the first. A nearest-texel lookup (a planted bug once: it passed the test below, which reads texels
 // far from any boundary) is off by up to half a step. Both texel formats: linear floats
 // (f(x) = x), and 8-bit sRGB codes decoded through the table (f(x) = the linear value of
 // code 50 x), which a lookup that skipped or misindexed the table would miss.

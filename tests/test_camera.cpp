@@ -61,7 +61,7 @@ TEST(Camera, BadCameraFilesNameTheProblem) {
   EXPECT_NE(message(R"({"eye": [0,0,0], "target": [0,0,0], "fov_y_deg": 40})").find("coincide"), std::string::npos);
   EXPECT_NE(message(R"({"eye": [0,1,0], "target": [0,0,0], "up": [0,1,0], "fov_y_deg": 40})").find("parallel"),
             std::string::npos);
-  // Finite, but their difference overflows a float: the real reason, not "parallel" (issue 17, row 15).
+  // Finite, but their difference overflows a float: the real reason, not "parallel".
   EXPECT_NE(message(R"({"eye": [1e38,0,3], "target": [-1e38,0,0], "fov_y_deg": 40})").find("too far apart"),
             std::string::npos);
   EXPECT_NE(message(R"({"eye": [1e20,0,0], "target": [0,0,0], "fov_y_deg": 40})").find("too far apart"),

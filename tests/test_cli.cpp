@@ -31,14 +31,14 @@ TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
       {"--width 100000 --height 100000", "is more than the 268 million pixels"},
       {"--camera /nonexistent/cam.json", "--camera '/nonexistent/cam.json': file not found"},
       {"/nonexistent/scene.obj", "scene '/nonexistent/scene.obj': file not found"},
-      // Issue 17, rows 9-11 and 17.
+      // Values a hostile user tried: negative radiance, non-finite and zero budgets, repeats.
       {"--env=-1,0,0", "--env '-1,0,0': radiance cannot be negative"},
       {"--time nan", "--time must be a finite number of seconds"},
       {"--time inf", "--time must be a finite number of seconds"},
       {"--spp 0", "--spp must be at least 1"},
       {"--wavefront 0", "--wavefront must be at least 64"},
       {"--spp 1 --spp 2", "fredholm: error: --spp"},
-      // Issue 13: the strategy and roulette flags.
+      // The strategy and roulette flags.
       {"--strategy vector", "--strategy 'vector': unknown strategy (use auto, scalar, simd8, megakernel or megakernel8)"},
       {"--rr-depth 0", "--rr-depth must be at least 1"},
   };
@@ -113,7 +113,7 @@ TEST(RenderCli, TimeBudgetEndsOnWholePasses) {
 
 // Ctrl-C or kill during a long render, on one device and on two: the passes finished so
 // far are written, the image says it is incomplete and how many samples it holds, and the
-// exit code is 128 + the signal, as for a process the signal killed (issue 17, row 5).
+// exit code is 128 + the signal, as for a process the signal killed.
 TEST(RenderCli, ASignalWritesThePassesFinishedSoFar) {
   const std::string dir = test::tempDir("signal");
   const std::string env = "POCL_DEVICES='pthread basic'";
@@ -147,7 +147,7 @@ TEST(RenderCli, ASignalWritesThePassesFinishedSoFar) {
 
 // A disk that fills mid-write, simulated by a file-size limit (with SIGXFSZ ignored a write
 // past it fails as on a full disk): a one-line error naming the file, exit 1, the file
-// that was there untouched and no temporary file left (issue 17, rows 6, 7 and 16).
+// that was there untouched and no temporary file left.
 TEST(RenderCli, AFullDiskLeavesTheOldFileAndNoPartOfTheNew) {
   const std::string dir = test::tempDir("full");
   auto bytes = [](const std::string& path) {
@@ -179,7 +179,7 @@ TEST(RenderCli, AFullDiskLeavesTheOldFileAndNoPartOfTheNew) {
     EXPECT_EQ(entry.path().filename().string().find("fredholm-tmp"), std::string::npos) << entry.path();
 }
 
-// A wavefront larger than the passes in flight can fill is cut to what they can (row 12).
+// A wavefront larger than the passes in flight can fill is cut to what they can.
 TEST(RenderCli, WavefrontIsCappedAtWhatTheImageCanUse) {
   const std::string dir = test::tempDir("cli");
   const auto r = test::runFredholm("render --width 16 --height 16 --spp 4 --wavefront 100000000 -o " + dir +
@@ -190,7 +190,7 @@ TEST(RenderCli, WavefrontIsCappedAtWhatTheImageCanUse) {
   EXPECT_EQ(stats["samples"], 16 * 16 * 4);
 }
 
-// A texture that cannot be decoded is named in a warning with its material (row 8).
+// A texture that cannot be decoded is named in a warning with its material.
 TEST(RenderCli, AnUnreadableTextureIsAWarningNamingItAndItsMaterial) {
   const std::string dir = test::tempDir("cli");
   test::writeFile(dir + "/t.obj", "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"

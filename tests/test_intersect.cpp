@@ -663,7 +663,7 @@ TEST(Watertight, RaysAtSharedEdgesAndVerticesNeverMiss) {
 
 // Axis-aligned geometry and rays, as in a box scene seen straight on: the edge functions
 // of a ray through a shared edge or vertex are exactly zero, the case the watertight test
-// must count as inside for one triangle of every pair (issue 17: a one-sided `<=` there
+// must count as inside for one triangle of every pair (a planted bug once: a one-sided `<=` there
 // passed every other test and left seams where walls meet). Each axis-aligned face of a
 // grid is hit through its vertices, edge midpoints and diagonals, from its front, along
 // each axis.

@@ -493,7 +493,7 @@ TEST(PathTracer, NoNonFiniteSamplesOnAnyCorpusScene) {
 
 // The pixel filters' importance sampling: offsets drawn through each tabulated inverse CDF
 // (interpolated as kernels/film.h does) follow the filter's own shape, written out here
-// independently (issue 17: a Gaussian sampled as a box passed every test).
+// independently (a Gaussian sampled as a box once passed every test).
 TEST(PixelFilters, ImportanceSamplesFollowEachFiltersShape) {
   struct Shape {
     PixelFilter filter;

@@ -101,7 +101,7 @@ TEST_F(PixelSamplerOnDevice, TwoReplicatesAreTwoIndependentNets) {
 
 // A pixel's first two samples lie in opposite halves of every dimension (the net), but
 // where in each half is random: their difference, across pixels, is spread out. Sobol'
-// points with the index shuffled but the values not scrambled (issue 17: unbiased, so no
+// points with the index shuffled but the values not scrambled (a planted bug once: unbiased, so no
 // other test saw it) put every pixel's second sample exactly half a unit from its first.
 TEST_F(PixelSamplerOnDevice, APixelsFirstTwoSamplesAreNotAFixedDistanceApart) {
   const unsigned pixels = 16384;

@@ -230,7 +230,7 @@ TEST_F(BadInput, IndicesOutOfRange) {
             std::string::npos);
 }
 
-// Found by fuzzing (issue 17, rows 1-4): inputs the lint passed and the loader read
+// Found by fuzzing: inputs the lint passed and the loader read
 // differently, which crashed or sent out-of-range indices to the device.
 TEST_F(BadInput, FaceElementEndingInASlash) {
   EXPECT_NE(errorFor("v 1 0 0\nv 0 1 0\nv 0 1 0\nf 1/ 2 3\n").find("scene.obj:4: face element '1/' ends in '/'"),
@@ -262,7 +262,7 @@ TEST_F(BadInput, IndicesBeyondAnyIntegerType) {
             std::string::npos);
 }
 
-// Devices and FIFOs would block or never end: refused by name (issue 17, row 13).
+// Devices and FIFOs would block or never end: refused by name.
 TEST_F(BadInput, FilesThatAreNotRegularFiles) {
   EXPECT_NE(errorFor("mtllib /dev/zero\n" + std::string(kTriangle) + "f 1 2 3\n")
                 .find("scene.obj:1: mtllib '/dev/zero': is not a regular file"),
@@ -285,7 +285,7 @@ TEST_F(BadInput, FilesThatAreNotRegularFiles) {
 }
 
 // Only the materials the OBJ uses are kept: memory follows the scene, not the library
-// (issue 17, row 14: a million unused materials cost 2.2 GB).
+// (a million unused materials once cost gigabytes).
 TEST_F(BadInput, UnusedMaterialsAreNotKept) {
   std::string mtl = "# a big library\n";
   for (int i = 0; i < 20000; ++i) mtl += "newmtl m" + std::to_string(i) + "\nKd 0.5 0.5 0.5\n";

@@ -123,7 +123,7 @@ bool WavefrontPipeline::launches(Stage s) const {
 }
 
 size_t defaultWavefront(const DeviceInfo& device, size_t pixels) {
-  // GPU: the best of the H200 sweep in bench/RESULTS.md (issue 12); larger wavefronts ran emptier.
+  // GPU: the best of the H200 sweep (bench/history/gpu.md); larger wavefronts ran emptier.
   const size_t preferred = device.type == "gpu" ? (size_t(1) << 19) : (size_t(1) << 16);
   return std::max<size_t>(kLocalSize, std::min(preferred, 2 * pixels));
 }
