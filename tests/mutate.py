@@ -1,84 +1,266 @@
 #!/usr/bin/python3
-"""How strong is the suite? Plants one-line bugs, one at a time, and runs tests against each.
+"""How strong is the suite? Plants one-line bugs, one at a time, and runs the tests that should catch each.
 
-  tests/mutate.py [--build build] [--all-tests] [--only NAME ...]
+  tests/mutate.py [--build build] [--only NAME ...] [--all-tests]   plant, rebuild, test, restore
+  tests/mutate.py --list                                            each mutation and the bug it models
+  tests/mutate.py --check [--root DIR]                              every original text occurs once
 
-Each mutation replaces one exact piece of source text (which must occur exactly once),
-rebuilds, and runs the tests that should catch it (its CTest regex), or the whole suite
-with --all-tests (minutes per mutation). A mutation the tests pass is a gap. The source is
-restored after each, and the build rebuilt at the end. Re-run after big changes (the CPU
-speed work) to see the suite still catches what it caught.
+Each mutation replaces one exact piece of source text, which must occur exactly once in its
+file, rebuilds, and runs the CTest regex of the tests that should catch it (the whole suite
+with --all-tests: minutes per mutation). It prints one line per mutation: caught, MISSED (a
+gap in the suite), does not build, no tests (its regex matches none) or stale (its text is
+no longer in the source exactly once), then "N of M mutations caught". The source is
+restored after each, also on Ctrl-C, and the build rebuilt at the end. --check (CTest
+Mutations.EveryTextOccursOnce) keeps the texts from going stale unnoticed.
 """
-import argparse, os, subprocess, sys
+import argparse, collections, os, re, signal, subprocess, sys
 
-# name, file, original text, mutated text, what it models, tests that should catch it
-MUTATIONS = [
-    ("crack", "kernels/intersect.h", "((u < zero) | (v < zero) | (w < zero))",
-     "((u <= zero) | (v < zero) | (w < zero))", "a one-sided crack in the watertight test", "Watertight"),
-    ("nearest-texel", "kernels/surface.h", "const float tx = x - fx, ty = y - fy;",
-     "const float tx = round(x - fx), ty = round(y - fy);", "nearest instead of bilinear lookup", "Textures"),
+Mutation = collections.namedtuple("Mutation", "name path original mutated models tests")
+
+# (name, file, original text, mutated text, the bug it models, CTest regex of the tests that should catch it).
+# Regexes are anchored (^) so the strategy reruns (scalar/..., simd8/..., megakernel/...) are left out.
+MUTATIONS = [Mutation(*m) for m in [
+    # Geometry, texture, filter and sampler.
+    ("crack", "kernels/intersect.h",
+     "const int8 outside = (min8(min8(u, e.v), e.w) < zero) & (max8(max8(u, e.v), e.w) > zero);",
+     "const int8 outside = ((min8(min8(u, e.v), e.w) < zero) | (u == zero)) & (max8(max8(u, e.v), e.w) > zero);",
+     "a one-sided crack in the watertight test (a hit on one edge counts as outside)", r"^Watertight\."),
+    ("nearest-texel", "kernels/surface.h", "const lfloat tx = x - fx, ty = y - fy;",
+     "const lfloat tx = round(x - fx), ty = round(y - fy);", "nearest instead of bilinear texture lookup",
+     r"^Textures\."),
+    ("texture-v-down", "kernels/surface.h", "y = (1.0f - (v - floor(v))) * h - 0.5f;", "y = (v - floor(v)) * h - 0.5f;",
+     "texture v running down the image (OBJ's runs up)", r"^Textures\."),
+    ("shading-normal-unturned", "kernels/surface.h",
+     "return v3_select(!(v3_dot(n, n) > 0.0f), ng, v3_select(v3_dot(ns, ng) >= 0.0f, ns, v3_neg(ns)));",
+     "return v3_select(!(v3_dot(n, n) > 0.0f), ng, ns);",
+     "shading normals not turned to the geometric normal's side",
+     r"^PathTracer/EveryMethod\.VertexNormalsAgainstTheWinding"),
+    ("camera-aspect", "host/scene/camera.cpp", "p.right[k] = f.right[size_t(k)] * f.tanHalfFovY * f.aspect;",
+     "p.right[k] = f.right[size_t(k)] * f.tanHalfFovY;", "the device camera without the aspect ratio (wide images squeezed)",
+     r"^AovRender\."),
     ("gaussian-as-box", "host/render/pixel_filter.cpp",
      "return std::max(0.0, std::exp(-x * x / (2 * sigma * sigma)) - std::exp(-radius * radius / (2 * sigma * sigma)));",
-     "return 1.0 + 0.0 * sigma;", "the Gaussian filter sampled as a box", "PixelFilters"),
-    ("no-owen-values", "kernels/sampler.h", "return u32_to_unit_float(reverse_bits_u32(owen_hash(digits_reversed, seed)));",
+     "return 1.0 + 0.0 * sigma;", "the Gaussian filter sampled as a box", r"^PixelFilters\."),
+    ("no-owen-values", "kernels/sampler.h",
+     "return u32_to_unit_float(reverse_bits_u32(owen_hash(digits_reversed, seed)));",
      "return u32_to_unit_float(reverse_bits_u32(digits_reversed + 0u * seed));",
-     "sample values not Owen-scrambled (index shuffle kept)", "PixelSampler"),
-    ("ggx-pdf", "kernels/bsdf.h", "return ggx_g1(wo, a) * ggx_d(h, a) / (4.0f * wo.z);",
-     "return 1.1f * ggx_g1(wo, a) * ggx_d(h, a) / (4.0f * wo.z);", "a 10 % GGX pdf error", "Bsdf|WhiteFurnace"),
-    ("mis-half", "kernels/lights.h", "return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;",
-     "return a2 + b2 > 0.0f ? 0.5f : 0.0f;", "a constant one-half MIS weight", "PathTracer|WhereMethodsFail"),
-    ("roulette", "kernels/shade.cl", "else beta /= survive;", "else beta /= 1.0f;",
-     "Russian roulette without dividing by survival", "PathTracer|WhereMethodsFail"),
-    ("light-pdf", "kernels/lights.h", "if (l->seen.solid_angle > 0.0f) return l->pick / l->seen.solid_angle;",
-     "if (l->seen.solid_angle > 0.0f) return 2.0f * l->pick / l->seen.solid_angle;", "a doubled light pdf",
-     "PathTracer|WhereMethodsFail"),
-    ("back-emission", "kernels/shade.cl", "if (cos_front > 0.0f && (ke.x > 0.0f",
-     "if (cos_front != 0.0f && (ke.x > 0.0f", "emission from the back side too", "PathTracer|WhereMethodsFail"),
-]
+     "sample values not Owen-scrambled (index shuffle kept)", r"^PixelSamplerOnDevice\."),
+    # Materials.
+    ("ggx-pdf", "kernels/bsdf.h", "return select(ggx_g1(wo, a) * ggx_d(h, a) / (4.0f * wo.z),",
+     "return select(1.1f * ggx_g1(wo, a) * ggx_d(h, a) / (4.0f * wo.z),", "a 10 % GGX pdf error",
+     r"^BsdfOnDevice\."),
+    ("ggx-no-cos-wi", "kernels/bsdf.h", "/ (4.0f * wo.z * wi.z)", "/ (4.0f * wo.z)",
+     "GGX evaluated without wi.z in the microfacet denominator", r"^BsdfOnDevice\.Glossy"),
+    ("schlick-power-4", "kernels/bsdf.h", "const lfloat m5 = m * m * m * m * m;", "const lfloat m5 = m * m * m * m;",
+     "Schlick's Fresnel with exponent 4 instead of 5", r"^BsdfOnDevice\.Glossy"),
+    ("ns-roughness-no-sqrt", "kernels/bsdf.h", "return sqrt(2.0f / (fmax(ns, 0.0f) + 2.0f));",
+     "return 2.0f / (fmax(ns, 0.0f) + 2.0f);", "Ns mapped to alpha squared, not alpha = sqrt(2 / (Ns + 2))",
+     r"^BsdfOnDevice\.Glossy"),
+    ("fresnel-p-as-s", "kernels/bsdf.h", "const lfloat rp = (eta * cos_i - ct) / (eta * cos_i + ct);",
+     "const lfloat rp = (cos_i - eta * ct) / (cos_i + eta * ct);",
+     "the dielectric's p-polarised reflectance written like the s one", r"^BsdfOnDevice\.(Dielectric|Glass)"),
+    # Light transport.
+    ("mis-half", "kernels/lights.h", "return select((lfloat)(0.0f), a2 / (a2 + b2), a2 + b2 > 0.0f);",
+     "return select((lfloat)(0.0f), (lfloat)(0.5f), a2 + b2 > 0.0f);", "a constant one-half MIS weight",
+     r"^PathTracer\.MethodsAgreeOnTheCornellBox|^WhereMethodsFail\.TinyBrightLight"),
+    ("light-pdf", "kernels/lights.h", "l->pick / l->seen.solid_angle,", "2.0f * l->pick / l->seen.solid_angle,",
+     "a doubled light pdf (solid-angle sampling)",
+     r"^PathTracer/EveryMethod\.ClosedFurnaceBox|^WhereMethodsFail\.(ExtremeScales|DegenerateTriangles)"),
+    ("roulette", "kernels/shade_stage.h", "v3_scale(beta, 1.0f / survive)", "v3_scale(beta, 1.0f)",
+     "Russian roulette without dividing by survival",
+     r"^WhereMethodsFail\.AlbedoNearOneRoulette|^PathTracer/EveryMethod\.ClosedFurnaceBox"),
+    ("back-emission", "kernels/shade_stage.h", "const lmask emits = hits && sh->cos_front > 0.0f &&",
+     "const lmask emits = hits && sh->cos_front != 0.0f &&", "emission from the back side too",
+     r"^WhereMethodsFail\.NoLightsIsBlack|^PathTracer/EveryMethod\.VertexNormalsAgainstTheWinding"),
+    ("env-pdf-no-sin", "kernels/environment.h", "density / (FH_ENV_SOLID_ANGLE_PER_UV * sin_theta)",
+     "density / FH_ENV_SOLID_ANGLE_PER_UV",
+     "environment-map sampling's pdf without the sin(theta) of the lat-long map",
+     r"^Environment/EveryMethod\.|^EnvironmentMap\.(BesideATriangleLight|AConstantMap)"),
+    # The film and what carries it: adaptive rounds, chunks, checkpoints, MPI ranks.
+    ("adaptive-no-offsets", "host/render/pass_rounds.cpp", "offsets.push_back(uint32_t(counts[p]) - begin);",
+     "offsets.push_back(0u * (uint32_t(counts[p]) - begin));",
+     "adaptive rounds without per-pixel sequence offsets (pass k takes point k: scattered blocks)",
+     r"^AdaptiveCli\.EachPixelsSamplesAreTheFirstPoints"),
+    ("film-unquantized", "host/render/film.cpp",
+     "double quantized(float v) { return std::nearbyint(double(v) / kFilmQuantum) * kFilmQuantum; }",
+     "double quantized(float v) { return double(v); }",
+     "samples not rounded to the 2^-24 grid (sums depend on how passes are split)", r"^Chunks\."),
+    ("checkpoint-no-checksum", "host/render/checkpoint.cpp", "if (checksum(data, n) != h.checksums[section])",
+     "if (false && checksum(data, n) != h.checksums[section])",
+     "film files read without checking their sections' checksums",
+     r"^Checkpoint\.(AFlippedByte|MergeAndResumeRefuse)"),
+    ("mpi-reduce-max", "host/distributed/mpi_render.cpp", "MPI_DOUBLE, MPI_SUM, 0,", "MPI_DOUBLE, MPI_MAX, 0,",
+     "ranks' films merged by maximum instead of sum", r"^Mpi\.EveryRankCountGivesTheImageOfOneProcess"),
+]]
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def problem(m, root):
+    """What is wrong with mutation m's texts in the source at root, or None."""
+    try:
+        with open(os.path.join(root, m.path)) as f:
+            count = f.read().count(m.original)
+    except OSError as e:
+        return "cannot read %s (%s)" % (m.path, e.strerror)
+    if m.mutated == m.original:
+        return "its mutated text is the original"
+    if count != 1:
+        return "stale: its original text is not in %s" % m.path if count == 0 else \
+            "ambiguous: its original text is %d times in %s" % (count, m.path)
+    return None
+
+
+def check(root):
+    names = [m.name for m in MUTATIONS]
+    bad = [(n, "the name is used %d times" % names.count(n)) for n in sorted(set(names)) if names.count(n) > 1]
+    bad += [(m.name, p) for m in MUTATIONS for p in [problem(m, root)] if p]
+    for name, why in bad:
+        print("%s (%s): %s" % (name, dict((m.name, m.path) for m in MUTATIONS)[name], why))
+    if bad:
+        print("%d of %d mutations need their text updated (%s)" % (len(bad), len(MUTATIONS), root))
+        return 1
+    print("%d mutations: each original text occurs exactly once in its file (%s)" % (len(MUTATIONS), root))
+    return 0
 
 
 def run(cmd, cwd):
     return subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 
 
-def main():
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--build", default="build")
-    parser.add_argument("--all-tests", action="store_true")
-    parser.add_argument("--only", nargs="*")
-    opts = parser.parse_args()
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    env_dirs = {"POCL_CACHE_DIR": os.path.join(root, opts.build, "pocl-cache"),
-                "FREDHOLM_CACHE_DIR": os.path.join(root, opts.build, "program-cache")}
-    os.environ.update({k: os.environ.get(k, v) for k, v in env_dirs.items()})
-    results = []
-    for name, path, original, mutated, what, tests in MUTATIONS:
-        if opts.only and name not in opts.only:
-            continue
-        full = os.path.join(root, path)
-        with open(full) as f:
-            text = f.read()
-        if text.count(original) != 1:
-            results.append((name, what, "stale: the original text is not in " + path + " exactly once"))
-            continue
+class Planted:
+    """Mutation m planted in its file while in the with block; the file is restored on leaving it,
+    whatever ends the block (an error, Ctrl-C, SIGTERM), and a copy of the original kept in the build
+    tree until then names the file to mend should the process be killed outright."""
+
+    def __init__(self, m, root, build):
+        self.m, self.full = m, os.path.join(root, m.path)
+        self.backup = os.path.join(build, "mutate-backup", m.path.replace("/", "__"))
+
+    def __enter__(self):
+        with open(self.full) as f:
+            self.text = f.read()
+        self.planted = self.text.replace(self.m.original, self.m.mutated)
+        os.makedirs(os.path.dirname(self.backup), exist_ok=True)
+        with open(self.backup, "w") as f:
+            f.write(self.text)
+        with open(self.full, "w") as f:
+            f.write(self.planted)
+        return self
+
+    def __exit__(self, *exc):
+        signals = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, signals)  # a second Ctrl-C must not cut the restore short
         try:
-            with open(full, "w") as f:
-                f.write(text.replace(original, mutated))
-            build = run(["cmake", "--build", opts.build, "-j2"], root)
-            if build.returncode != 0:
-                results.append((name, what, "does not build"))
-                continue
-            cmd = ["ctest", "--test-dir", opts.build, "-j2"] + ([] if opts.all_tests else ["-R", tests])
-            caught = run(cmd, root).returncode != 0
-            results.append((name, what, "caught" if caught else "MISSED"))
+            with open(self.full) as f:
+                now = f.read()
+            if now == self.planted:
+                restored = self.text
+            elif now.count(self.m.mutated) == 1:  # someone else edited the file meanwhile: undo only the mutation
+                restored = now.replace(self.m.mutated, self.m.original)
+                print("note: %s changed while %s was planted; only the mutation was undone" % (self.m.path, self.m.name))
+            else:
+                print("ERROR: %s changed while %s was planted, and the mutation is not in it once: replace\n  %s\nby\n  %s"
+                      "\nby hand (the original file is in %s)" % (self.m.path, self.m.name, self.m.mutated,
+                                                                  self.m.original, self.backup), file=sys.stderr)
+                return False
+            with open(self.full, "w") as f:
+                f.write(restored)
+            os.remove(self.backup)
         finally:
-            with open(full, "w") as f:
-                f.write(text)
-        print("%-16s %-8s %s" % (name, results[-1][2], what), flush=True)
-    run(["cmake", "--build", opts.build, "-j2"], root)
-    missed = [r for r in results if r[2] != "caught"]
-    print("%d of %d mutations caught" % (len(results) - len(missed), len(results)))
-    sys.exit(1 if missed else 0)
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        return False
+
+
+def failed_tests(ctest_output):
+    """The names CTest lists under "The following tests FAILED:"."""
+    names, listing = [], False
+    for line in ctest_output.splitlines():
+        if line.startswith("The following tests FAILED"):
+            listing = True
+        elif listing:
+            found = re.match(r"\s*\d+ - (.*?) \(", line)
+            if not found:
+                break
+            names.append(found.group(1).split("  # ")[0])
+    return names
+
+
+def try_mutation(m, root, opts):
+    """Plants m, rebuilds and runs its tests: (status, detail)."""
+    why = problem(m, root)
+    if why:
+        return "stale", why
+    listed = run(["ctest", "--test-dir", opts.build, "-N", "-R", m.tests], root).stdout
+    if not re.search(r"Total Tests: [1-9]", listed):
+        return "no tests", "its regex %s matches no test in %s" % (m.tests, opts.build)
+    with Planted(m, root, opts.build):
+        build = run(["cmake", "--build", opts.build, "-j%d" % opts.jobs], root)
+        if build.returncode != 0:
+            return "does not build", ""
+        cmd = ["ctest", "--test-dir", opts.build, "-j%d" % opts.jobs, "--no-tests=error"]
+        tests = run(cmd + ([] if opts.all_tests else ["-R", m.tests]), root)
+    if tests.returncode == 0:
+        return "MISSED", m.tests
+    failed = failed_tests(tests.stdout)
+    return "caught", ("by %s" % failed[0] + (" and %d more" % (len(failed) - 1) if len(failed) > 1 else "")) \
+        if failed else ""
+
+
+def raise_interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--build", default="build", help="the build tree (default: build)")
+    parser.add_argument("--only", nargs="+", metavar="NAME", help="these mutations only")
+    parser.add_argument("--all-tests", action="store_true", help="run the whole suite against each mutation")
+    parser.add_argument("-j", "--jobs", type=int, default=2, help="build and test jobs (default: 2)")
+    parser.add_argument("--list", action="store_true", help="list the mutations and what they model")
+    parser.add_argument("--check", action="store_true", help="check every original text occurs once; run nothing")
+    parser.add_argument("--root", default=ROOT, help="the source tree (default: this script's)")
+    opts = parser.parse_args()
+    root = os.path.abspath(opts.root)
+    if opts.check:
+        sys.exit(check(root))
+    if opts.list:
+        for m in MUTATIONS:
+            print("%-24s %-32s %s" % (m.name, m.path, m.models))
+        return
+    unknown = [n for n in opts.only or [] if n not in {m.name for m in MUTATIONS}]
+    if unknown:
+        parser.error("no mutation named %s (see --list)" % ", ".join(unknown))
+    opts.build = os.path.join(root, opts.build)
+    leftover = os.path.join(opts.build, "mutate-backup")
+    if os.path.isdir(leftover) and os.listdir(leftover):
+        sys.exit("mutate.py: %s holds originals of files a killed run left mutated (names with / as __): "
+                 "mend those files, then remove the directory" % leftover)
+    for k, v in {"POCL_CACHE_DIR": "pocl-cache", "FREDHOLM_CACHE_DIR": "program-cache"}.items():
+        os.environ.setdefault(k, os.path.join(opts.build, v))
+    signal.signal(signal.SIGTERM, raise_interrupt)
+    signal.signal(signal.SIGHUP, raise_interrupt)
+    results = []
+    try:
+        for m in MUTATIONS:
+            if opts.only and m.name not in opts.only:
+                continue
+            status, detail = try_mutation(m, root, opts)
+            results.append(status)
+            print("%-24s %-15s %s%s" % (m.name, status, m.models, " (%s)" % detail if detail else ""), flush=True)
+    except KeyboardInterrupt:
+        print("interrupted: the source is restored", flush=True)
+    finally:
+        print("rebuilding %s without mutations" % opts.build, flush=True)
+        try:
+            rebuilt = run(["cmake", "--build", opts.build, "-j%d" % opts.jobs], root).returncode == 0
+        except KeyboardInterrupt:
+            rebuilt = False
+        if not rebuilt:
+            print("the build may still hold the last mutation: run cmake --build %s" % opts.build)
+    caught = results.count("caught")
+    print("%d of %d mutations caught" % (caught, len(results)))
+    sys.exit(0 if results and caught == len(results) else 1)
 
 
 if __name__ == "__main__":
