@@ -91,6 +91,9 @@ MUTATIONS = [Mutation(*m) for m in [
      r"^Checkpoint\.(AFlippedByte|MergeAndResumeRefuse)"),
     ("mpi-reduce-max", "host/distributed/mpi_render.cpp", "MPI_DOUBLE, MPI_SUM, 0,", "MPI_DOUBLE, MPI_MAX, 0,",
      "ranks' films merged by maximum instead of sum", r"^Mpi\.EveryRankCountGivesTheImageOfOneProcess"),
+    ("mpi-layers-unmerged", "host/distributed/mpi_render.cpp", "{&film.sum, &film.sumSq, &film.aovSum, &film.oddSum}",
+     "{&film.sum, &film.sumSq, &film.oddSum}", "the ranks' first-surface layers left out of the merge",
+     r"^Mpi\.EveryRankCountGivesTheImageOfOneProcess"),
 ]]
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

@@ -252,18 +252,6 @@ TEST(Checkpoint, RankFilesAreFoundUnderTheNamesRanksGiveThem) {
   EXPECT_EQ(relative, (std::vector<std::string>{rankCheckpointPath("ck", 0), rankCheckpointPath("ck", 12)}));
 }
 
-// Every channel of an EXR (the image and its layers), as stored.
-std::vector<float> exrChannels(const std::string& path, std::vector<std::string>* names = nullptr) {
-  auto in = OIIO::ImageInput::open(path);
-  EXPECT_TRUE(in) << path;
-  if (!in) return {};
-  const OIIO::ImageSpec& spec = in->spec();
-  std::vector<float> values(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
-  in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, values.data());
-  if (names) *names = spec.channelnames;
-  return values;
-}
-
 // Passes of samples over eleven decades (more than double precision adds exactly from
 // float samples), added one by one and as chunks merged in another
 // order: the film's sums (and so its image) are the same bits.
@@ -316,7 +304,8 @@ TEST(Chunks, MergedChunksAreTheBitsOfOneRender) {
   const auto merged = test::runFredholm("merge " + films + "--aovs albedo,depth,spp -o " + dir + "/merged.exr");
   ASSERT_EQ(merged.exitCode, 0) << merged.output;
   std::vector<std::string> names, oneNames;
-  const std::vector<float> a = exrChannels(dir + "/merged.exr", &names), b = exrChannels(dir + "/one.exr", &oneNames);
+  const std::vector<float> a = test::exrChannels(dir + "/merged.exr", &names);
+  const std::vector<float> b = test::exrChannels(dir + "/one.exr", &oneNames);
   EXPECT_EQ(names, oneNames);
   EXPECT_EQ(names.size(), 8u);  // R G B, albedo.R/G/B, depth.Z, spp.Y
   EXPECT_TRUE(a == b) << "the merged chunks differ from one render";

@@ -9,7 +9,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 #include <vector>
+
+#include <OpenImageIO/imageio.h>
 
 #include "accel/bvh.h"
 #include "base/test_hooks.h"
@@ -253,6 +256,16 @@ BruteHit bruteForceClosest(const Scene& scene, const double o[3], const double d
   }
   if (best.triangle < 0) best.t = INFINITY;
   return best;
+}
+
+std::vector<float> exrChannels(const std::string& path, std::vector<std::string>* names) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw std::runtime_error("cannot read " + path + ": " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  std::vector<float> values(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+  in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, values.data());
+  if (names) *names = spec.channelnames;
+  return values;
 }
 
 }  // namespace fh::test

@@ -41,6 +41,10 @@ std::string testScene(const std::string& relative);
 
 // A fresh empty directory under the system temp dir, removed at exit.
 std::string tempDir(const std::string& tag);
+
+// Every channel of an EXR (the image and its layers), as stored, pixel by pixel; `names`
+// gets the channels' names.
+std::vector<float> exrChannels(const std::string& path, std::vector<std::string>* names = nullptr);
 void writeFile(const std::string& path, const std::string& text);
 
 struct CommandResult {
