@@ -12,7 +12,7 @@ one; the two bodies are nearly the same instructions, so the work-group function
 matched to the kernel's (difflib over opcodes and operands, addresses masked), and each
 sample takes the inlining chain llvm-symbolizer gives for its matched address. Prints the
 share of the kernel's samples per stage function (what the kernel calls), per innermost
-function, per call chain, per source line and per innermost loop of the machine code (with
+function, per function with what it calls (inclusive), per call chain, per source line and per innermost loop of the machine code (with
 the lines most sampled in it). Needs perf (Debian linux-perf), llvm-symbolizer (llvm) and
 objdump (binutils).
 """
@@ -100,7 +100,7 @@ def profile(args, command, work):
                                 text=True).stdout.strip().split("\n\n")
 
     total = sum(by_address.values())
-    stage, inner, chain, lines = (collections.Counter() for _ in range(4))
+    stage, inner, chain, lines, inclusive = (collections.Counter() for _ in range(5))
     line_of = {}  # source address -> its innermost frame's function and file:line
     for address, frames in zip(addresses, symbolized):
         entries = frames.strip().split("\n")
@@ -113,9 +113,14 @@ def profile(args, command, work):
             lines[line_of[address]] += count
         stage[names[-2] if len(names) >= 2 else names[-1]] += count
         chain[" < ".join(names[:4])] += count
+        # A function's share with everything inlined into it, wherever it sits in the chain
+        # (a stage's ray traversal within it, say): each function counted once per sample.
+        for name in set(names):
+            inclusive[name] += count
     print(f"{args.kernel}: {total} samples in {os.path.relpath(library, cache)}, "
           f"{len(to_source)} of {len(target)} instructions matched to the kernel's line table")
     for title, counter in (("stage (called by the kernel)", stage), ("innermost function", inner),
+                           ("function, with what it calls (inclusive)", inclusive),
                            ("call chain", chain), ("source line", lines)):
         print(f"\n{title}:")
         for name, count in counter.most_common(args.top):
