@@ -37,12 +37,13 @@ __kernel void sample_bsdf(__global const GpuMaterial* m, float4 wo, uint seed, _
   scatter_xyzw(wi_pdf, i, s.wi, s.pdf, lanes_mask(true));
   scatter_xyzw(weight, i, s.weight, (lfloat)(0.0f), lanes_mask(true));
 }
-__kernel void eval_bsdf(__global const GpuMaterial* m, float4 wo, __global const float4* wi, __global float4* f) {
+// f(wo, wi), its red channel (the test materials are grey).
+__kernel void eval_bsdf(__global const GpuMaterial* m, float4 wo, __global const float4* wi, __global float* f) {
   const luint i = lane_positions(get_global_id(0) * FH_LANES);
   const MaterialLanes material = material_lanes(m, (lint)(0));
   const Bsdf b = material_bsdf(&material);
   const lvec3 value = bsdf_eval(&b, v3_uniform((float3)(0.0f, 0.0f, 1.0f)), v3_uniform(wo.xyz), gather_xyz(wi, i));
-  scatter_xyzw(f, i, value, (lfloat)(0.0f), lanes_mask(true));
+  scatter_float(f, i, value.x, lanes_mask(true));
 }
 __kernel void pdf_bsdf(__global const GpuMaterial* m, float4 wo, __global const float4* wi, __global float* pdf) {
   const luint i = lane_positions(get_global_id(0) * FH_LANES);
@@ -108,55 +109,39 @@ class BsdfOnDevice : public ::testing::Test {
     return s;
   }
 
+  // The pdf of sampling each direction (x, y, z, unused) in `dirs`, and f's red channel there:
+  // both strategies' code, which must agree bit for bit.
   std::vector<float> pdf(const gpu::GpuMaterial& m, const float3& wo, const std::vector<float>& dirs) {
-    const std::vector<float> one = pdf(programs[0], 1, m, wo, dirs), eight = pdf(programs[1], 8, m, wo, dirs);
-    EXPECT_EQ(one, eight) << "one lane and eight disagree";
-    return one;
+    return perDirection("pdf_bsdf", m, wo, dirs);
   }
-  std::vector<float> pdf(const cl::Program& program, size_t lanes, const gpu::GpuMaterial& m, const float3& wo,
-                         const std::vector<float>& dirs) {
-    const size_t n = dirs.size() / 4;
-    EXPECT_EQ(0u, n % lanes);
-    cl::Buffer mb = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, sizeof m, "material", &m);
-    cl::Buffer d = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, n * 16, "dirs", dirs.data());
-    cl::Buffer out = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, n * 4, "pdf");
-    cl::Kernel k = createKernel(program, "pdf_bsdf");
-    const cl_float4 w{{wo[0], wo[1], wo[2], 0.f}};
-    FH_CL(k.setArg(0, mb));
-    FH_CL(k.setArg(1, w));
-    FH_CL(k.setArg(2, d));
-    FH_CL(k.setArg(3, out));
-    FH_CL(dc.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n / lanes)));
-    std::vector<float> p(n);
-    FH_CL(dc.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * 4, p.data()));
-    return p;
-  }
-
-  // f(wo, wi) for each direction (x, y, z, unused) in `dirs`: red channel only, both strategies.
   std::vector<float> eval(const gpu::GpuMaterial& m, const float3& wo, const std::vector<float>& dirs) {
-    const std::vector<float> one = eval(programs[0], 1, m, wo, dirs), eight = eval(programs[1], 8, m, wo, dirs);
-    EXPECT_EQ(one, eight) << "one lane and eight disagree";
+    return perDirection("eval_bsdf", m, wo, dirs);
+  }
+  std::vector<float> perDirection(const char* kernel, const gpu::GpuMaterial& m, const float3& wo,
+                                  const std::vector<float>& dirs) {
+    const std::vector<float> one = perDirection(programs[0], 1, kernel, m, wo, dirs),
+                             eight = perDirection(programs[1], 8, kernel, m, wo, dirs);
+    EXPECT_EQ(one, eight) << kernel << ": one lane and eight disagree";
     return one;
   }
-  std::vector<float> eval(const cl::Program& program, size_t lanes, const gpu::GpuMaterial& m, const float3& wo,
-                          const std::vector<float>& dirs) {
+  // `kernel`(material, wo, directions, one float out per direction).
+  std::vector<float> perDirection(const cl::Program& program, size_t lanes, const char* kernel,
+                                  const gpu::GpuMaterial& m, const float3& wo, const std::vector<float>& dirs) {
     const size_t n = dirs.size() / 4;
     EXPECT_EQ(0u, n % lanes);
     cl::Buffer mb = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, sizeof m, "material", &m);
     cl::Buffer d = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, n * 16, "dirs", dirs.data());
-    cl::Buffer out = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, n * 16, "f");
-    cl::Kernel k = createKernel(program, "eval_bsdf");
+    cl::Buffer out = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, n * 4, kernel);
+    cl::Kernel k = createKernel(program, kernel);
     const cl_float4 w{{wo[0], wo[1], wo[2], 0.f}};
     FH_CL(k.setArg(0, mb));
     FH_CL(k.setArg(1, w));
     FH_CL(k.setArg(2, d));
     FH_CL(k.setArg(3, out));
     FH_CL(dc.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(n / lanes)));
-    std::vector<float> f(n * 4);
-    FH_CL(dc.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * 16, f.data()));
-    std::vector<float> red(n);
-    for (size_t i = 0; i < n; ++i) red[i] = f[4 * i];
-    return red;
+    std::vector<float> values(n);
+    FH_CL(dc.queue.enqueueReadBuffer(out, CL_TRUE, 0, n * 4, values.data()));
+    return values;
   }
 };
 

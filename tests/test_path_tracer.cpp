@@ -123,19 +123,23 @@ TEST_P(EveryMethod, ClosedFurnaceBoxIsLeOverOneMinusRho) {
   }
 }
 
-TEST_P(EveryMethod, PlaneUnderRectangularEmitterFollowsLambertsFormula) {
-  const Scene scene = PlaneUnderLight::scene();
+// Renders `scene` (the plane under a light, perhaps with other normals) with the test's
+// method and holds it to the plane's exact image (box filter, 8x8 grid per pixel); pixels
+// whose footprint sees more than one surface are skipped.
+void expectLambertsPlane(const Scene& scene, Method method, const std::string& what) {
   const int size = 24;
   RenderSettings s = test::renderSettings();
-  s.method = GetParam();
+  s.method = method;
   s.width = s.height = size;
   s.spp = 256;
   const RenderResult r = test::render(scene, scene.camera, s);
   EXPECT_EQ(r.stats.nonfinite, 0u);
-  // The exact pixel values (box filter, 8x8 grid per pixel); pixels whose footprint sees
-  // more than one surface are skipped.
   const Image exact = PlaneUnderLight::reference(scene.camera, size, size, 8, true);
-  expectMatches(r.film, [&](size_t p) { return double(exact.rgb[3 * p]); }, methodName(GetParam()));
+  expectMatches(r.film, [&](size_t p) { return double(exact.rgb[3 * p]); }, what);
+}
+
+TEST_P(EveryMethod, PlaneUnderRectangularEmitterFollowsLambertsFormula) {
+  expectLambertsPlane(PlaneUnderLight::scene(), GetParam(), methodName(GetParam()));
 }
 
 // Vertex normals that oppose the winding are turned to the geometric normal's side: the
@@ -147,22 +151,10 @@ TEST_P(EveryMethod, VertexNormalsAgainstTheWindingShadeLikeFlatFaces) {
   scene.cornerNormals.clear();
   for (size_t t = 0; t < scene.triangleCount(); ++t) {
     const Vec3f a = scene.corner(t, 0), b = scene.corner(t, 1), c = scene.corner(t, 2);
-    const Vec3f e1{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    Vec3f n{e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
-    const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    for (int k = 0; k < 3; ++k)
-      for (int i = 0; i < 3; ++i) scene.cornerNormals.push_back(-n[size_t(i)] / len);
+    const Vec3f against = normalize(cross(c - a, b - a));  // the front is cross(b - a, c - a)
+    for (int k = 0; k < 3; ++k) scene.cornerNormals.insert(scene.cornerNormals.end(), against.begin(), against.end());
   }
-  const int size = 24;
-  RenderSettings s = test::renderSettings();
-  s.method = GetParam();
-  s.width = s.height = size;
-  s.spp = 256;
-  const RenderResult r = test::render(scene, scene.camera, s);
-  EXPECT_EQ(r.stats.nonfinite, 0u);
-  const Image exact = PlaneUnderLight::reference(scene.camera, size, size, 8, true);
-  expectMatches(r.film, [&](size_t p) { return double(exact.rgb[3 * p]); },
-                std::string(methodName(GetParam())) + ", normals against the winding");
+  expectLambertsPlane(scene, GetParam(), std::string(methodName(GetParam())) + ", normals against the winding");
 }
 
 // Adaptive sampling keeps each pixel its own mean: the same closed form holds where pixels
