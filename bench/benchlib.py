@@ -27,12 +27,15 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FREDHOLM = os.path.join(ROOT, "build", "fredholm")
-# Mitsuba 3's scripts (cbox.py, compare.py): the peers' checkout beside the repository, or --mitsuba-dir.
-MITSUBA_DIR = os.path.join(ROOT, "..", "shared", "peers", "mitsuba")
+# Mitsuba 3 on an OBJ+MTL scene, as fredholm reads it (run under --mitsuba-python).
+MITSUBA_RENDER = os.path.join(ROOT, "bench", "peers", "mitsuba_render.py")
 # The Cornell box view of the comparisons with Mitsuba (the peer issue's camera, at most 16 bounces, 512x512).
 PEER_VIEW = ["--width", "512", "--height", "512", "--eye", "0,1,3.5", "--target", "0,1,0", "--fov", "40",
              "--max-depth", "16"]
 PEER_PIXELS = 512 * 512
+# The same view for bench/peers/mitsuba_render.py (its scene is the same Cornell box by default).
+MITSUBA_PEER_VIEW = ["--width", "512", "--height", "512", "--eye", "0,1,3.5", "--target", "0,1,0", "--fov", "40",
+                     "--max-bounces", "16"]
 
 
 def results_path(*parts):
@@ -65,9 +68,6 @@ _COMMON = {  # flag: (its flags, argparse settings)
     "--ref-spp": (("--ref-spp",), dict(type=int, default=4096, help="samples per pixel of the reference")),
     "--mitsuba-python": (("--mitsuba-python",),
                          dict(default="/opt/mi-venv/bin/python", help="a Python that imports mitsuba")),
-    "--mitsuba-dir": (("--mitsuba-dir",),
-                      dict(default=MITSUBA_DIR, help="Mitsuba's cbox.py and compare.py (default: "
-                                                     "../shared/peers/mitsuba)")),
 }
 
 
@@ -204,10 +204,10 @@ def image_metadata(image):
     return fields
 
 
-def mitsuba(python, script, args, folder=MITSUBA_DIR):
-    """Runs one of Mitsuba's scripts (cbox.py, compare.py) under python; returns the JSON of
-    the last line of its output that holds one."""
-    out = run([python, os.path.join(folder, script)] + list(args), stdout=True).stdout
+def mitsuba(python, args):
+    """Renders with Mitsuba 3 (bench/peers/mitsuba_render.py ARGS) under python; returns the
+    JSON line it prints (samples_per_second, seconds_render, spp, mean_rgb, ...)."""
+    out = run([python, MITSUBA_RENDER] + list(args), stdout=True).stdout
     return json.loads([line for line in out.splitlines() if line.lstrip().startswith("{")][-1])
 
 

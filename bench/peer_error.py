@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """Error against time on the Cornell box at 512x512 (at most 16 bounces, the issue's camera):
 fredholm's methods and Mitsuba 3 (llvm_ad_rgb, ldsampler and independent samplers) on the
-same axes, each image measured against one long reference with Mitsuba's compare.py
-(relMSE with epsilon 1e-2, the reference box-downsampled if larger).
+same axes, each image measured against one long reference of the same size by `fredholm
+compare` (relMSE per channel, epsilon 1e-2).
 
   bench/peer_error.py --ref REF.exr [--spp 4,16,64,256] [--methods mis,nee,pt]
                       [--mitsuba-python /opt/mi-venv/bin/python] [--out bench/results/peers]
@@ -34,8 +34,8 @@ import benchlib  # noqa: E402  (beside this script)
 
 
 def relmse(opts, image):
-    """relMSE of image against opts.ref by Mitsuba's compare.py."""
-    return benchlib.mitsuba(opts.mitsuba_python, "compare.py", [opts.ref, image], opts.mitsuba_dir)["relMSE"]
+    """relMSE of image against opts.ref."""
+    return benchlib.compare(image, opts.ref, opts.binary)["relmse"]
 
 
 def fredholm(opts, method, spp, extra, workdir, seconds=None, seed=None):
@@ -50,9 +50,8 @@ def fredholm(opts, method, spp, extra, workdir, seconds=None, seed=None):
 
 def mitsuba(opts, sampler, spp, workdir, seed=None):
     image = os.path.join(workdir, "m.exr")
-    doc = benchlib.mitsuba(opts.mitsuba_python, "cbox.py", ["--variant", "llvm_ad_rgb", "--sampler", sampler,
-                                                            "--spp", str(spp), "--seed", str(seed or spp),
-                                                            "--max-bounces", "16", "--out", image], opts.mitsuba_dir)
+    doc = benchlib.mitsuba(opts.mitsuba_python, ["--variant", "llvm_ad_rgb", "--sampler", sampler, "--spp", str(spp),
+                                                 "--seed", str(seed or spp), "--out", image] + benchlib.MITSUBA_PEER_VIEW)
     return image, doc["seconds_render"]
 
 
@@ -60,7 +59,7 @@ def main():
     ap = argparse.ArgumentParser()
     benchlib.add_arguments(ap, "--ref", ref=dict(required=True))
     ap.add_argument("--spp", default="4,16,64,256")
-    benchlib.add_arguments(ap, "--methods", "--mitsuba-python", "--mitsuba-dir", "--out", "--binary",
+    benchlib.add_arguments(ap, "--methods", "--mitsuba-python", "--out", "--binary",
                            methods="mis,nee,pt", out=benchlib.results_path("peers"))
     ap.add_argument("--equal-time-rounds", type=int, default=0)
     opts, extra = benchlib.parse_with_rest(ap)

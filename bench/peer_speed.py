@@ -4,11 +4,11 @@ drifts by tens of percent between runs, so only interleaved figures compare).
 
   bench/peer_speed.py [--rounds 3] [--spp 64] [--mitsuba-python /opt/mi-venv/bin/python]
                       [--strategies megakernel8,simd8] [--rr-depths 6] [--fredholm build/fredholm]
-                      [--baseline OLD]
+                      [--baseline OLD] [--scene OBJ]
 
 Each round renders the Cornell box at 512x512 with at most 16 bounces (the camera of the
-issue: eye 0,1,3.5, target 0,1,0, fov 40) with fredholm `mis` under each strategy and with
-Mitsuba's llvm_ad_rgb variant (../shared/peers/mitsuba/cbox.py), the order rotated every
+issue: eye 0,1,3.5, target 0,1,0, fov 40; or --scene OBJ with its camera sidecar) with
+fredholm `mis` under each strategy and with Mitsuba's llvm_ad_rgb variant (bench/peers/mitsuba_render.py), the order rotated every
 round (and, with --baseline, an older fredholm binary without --strategy), and prints each
 renderer's Msamples/s per round and median, then each fredholm kernel's median time per
 sample (--stats "kernels"). The first render of each is a warm-up (kernel compilation,
@@ -19,37 +19,45 @@ import argparse, os, statistics, tempfile
 import benchlib
 
 
-def fredholm(binary, strategy, spp, workdir, rr_depth=None):
+def views(scene):
+    """(fredholm's, Mitsuba's) flags for the scene: the peer view of the Cornell box, or an
+    OBJ's own camera sidecar, at 512x512 and at most 16 bounces."""
+    if not scene:
+        return benchlib.PEER_VIEW, benchlib.MITSUBA_PEER_VIEW
+    size = ["--width", "512", "--height", "512"]
+    return [scene] + size + ["--max-depth", "16"], [scene] + size + ["--max-bounces", "16"]
+
+
+def fredholm(binary, strategy, spp, workdir, rr_depth=None, scene=""):
     """Renders; returns the --stats JSON."""
     choice = (["--strategy", strategy] if strategy else []) + (["--rr-depth", str(rr_depth)] if rr_depth else [])
-    return benchlib.render(["--spp", str(spp), "--method", "mis"] + benchlib.PEER_VIEW + choice,
+    return benchlib.render(["--spp", str(spp), "--method", "mis"] + views(scene)[0] + choice,
                            os.path.join(workdir, "f.pfm"), binary, stats=os.path.join(workdir, "s.json"))
 
 
 def mitsuba(opts, workdir):
-    """Renders with Mitsuba's cbox.py; returns its JSON line (samples_per_second...)."""
-    return benchlib.mitsuba(opts.mitsuba_python, "cbox.py", ["--variant", "llvm_ad_rgb", "--spp", str(opts.spp),
-                                                             "--max-bounces", "16", "--threads", "2", "--out",
-                                                             os.path.join(workdir, "mi.exr")], opts.mitsuba_dir)
+    """Renders with Mitsuba; returns its JSON line (samples_per_second...)."""
+    return benchlib.mitsuba(opts.mitsuba_python, ["--variant", "llvm_ad_rgb", "--spp", str(opts.spp), "--threads", "2",
+                                                  "--out", os.path.join(workdir, "mi.exr")] + views(opts.scene)[1])
 
 
 def main():
     ap = argparse.ArgumentParser()
-    benchlib.add_arguments(ap, "--rounds", "--spp", "--mitsuba-python", "--mitsuba-dir", rounds=3, spp=64)
+    benchlib.add_arguments(ap, "--rounds", "--spp", "--mitsuba-python", rounds=3, spp=64)
     ap.add_argument("--strategies", default="megakernel8,simd8")
-    benchlib.add_arguments(ap, "--binary")
+    benchlib.add_arguments(ap, "--binary", "--scene")
     ap.add_argument("--baseline", help="an older fredholm binary (run without --strategy)")
     ap.add_argument("--rr-depths", default="6",
                     help="fredholm's roulette starts to run (6 is Mitsuba's rr_depth 5: the same work per sample)")
     opts = ap.parse_args()
     with tempfile.TemporaryDirectory() as workdir:
         def current(strategy, rr_depth):
-            return lambda r: fredholm(opts.binary, strategy, opts.spp, workdir, rr_depth)
+            return lambda r: fredholm(opts.binary, strategy, opts.spp, workdir, rr_depth, opts.scene)
 
         runners = {"fredholm mis %s rr%s" % (s, rr): current(s, rr)
                    for rr in opts.rr_depths.split(",") for s in opts.strategies.split(",")}
         if opts.baseline:
-            runners["fredholm mis baseline"] = lambda r: fredholm(opts.baseline, None, opts.spp, workdir)
+            runners["fredholm mis baseline"] = lambda r: fredholm(opts.baseline, None, opts.spp, workdir, scene=opts.scene)
         runners["mitsuba llvm_ad_rgb"] = lambda r: mitsuba(opts, workdir)
         names = list(runners)
 

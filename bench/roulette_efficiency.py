@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """Where Russian roulette should start: the Cornell box at 512x512 (at most 16 bounces, the
 issue's camera, peer_error.py's settings) rendered at a fixed sample count with roulette from
-each bounce given, each image measured against one long reference (Mitsuba's compare.py:
-relMSE with epsilon 1e-2). An unbiased estimator's relMSE falls as 1/time, so relMSE x
+each bounce given, each image measured against one long reference (`fredholm compare`:
+relMSE per channel with epsilon 1e-2). An unbiased estimator's relMSE falls as 1/time, so relMSE x
 seconds is its cost at equal error: the lower, the better the start.
 
   bench/roulette_efficiency.py --ref REF.exr [--depths 4,5,6,7,8] [--spp 256] [--rounds 2]
@@ -23,7 +23,7 @@ def main():
     ap = argparse.ArgumentParser()
     benchlib.add_arguments(ap, "--ref", ref=dict(required=True, help="long reference render of the same view (EXR)"))
     ap.add_argument("--depths", default="4,5,6,7,8", help="roulette starts to compare (--rr-depth values)")
-    benchlib.add_arguments(ap, "--spp", "--rounds", "--method", "--mitsuba-python", "--mitsuba-dir", "--binary",
+    benchlib.add_arguments(ap, "--spp", "--rounds", "--method", "--binary",
                            spp=256, rounds=2)
     opts, extra = benchlib.parse_with_rest(ap)
     depths = [int(d) for d in opts.depths.split(",")]
