@@ -1,12 +1,11 @@
 #!/bin/sh
 # Every error-against-time chart of bench/RESULTS.md and the method x scene table, from a
-# fresh clone (after ./setup.sh build; ../shared/scenes beside the repository for the
-# archive's scenes). About 8 minutes on 2 cores. CSVs and charts land in bench/results/convergence/,
+# fresh clone (after ./setup.sh build; Veach's scene, which does not ship, where
+# FREDHOLM_SCENES names the folder that holds veach-mis/). About 8 minutes on 2 cores. CSVs and charts land in bench/results/convergence/,
 # images and references in bench/out/converge/.
 set -eu
 cd "$(dirname "$0")/.."
 out=bench/out/converge
-shared=../shared/scenes
 mkdir -p "$out" bench/results/convergence
 
 chart() {  # chart NAME converge.py-arguments...
@@ -25,11 +24,12 @@ chart cornell-box --ref-spp 4096 --max-spp 256
 for s in caustic hidden-light tiny-light; do
   chart "$s" "scenes/failure/$s.obj" --ref-spp 4096 --max-spp 256
 done
-if [ -d "$shared" ]; then
-  chart CornellBox-Glossy "$shared/cornell-box/legacy-glossy-2011/CornellBox-Glossy.obj" --ref-spp 2048 --max-spp 128
-  chart veach_mis "$shared/veach-mis/veach_mis.obj" --width 192 --height 128 --ref-spp 2048 --max-spp 128
-  chart CornellBox-Water "$shared/cornell-box/CornellBox-Water.obj" --ref-spp 2048 --max-spp 128
+chart CornellBox-Glossy scenes/cornell-box/legacy-glossy-2011/CornellBox-Glossy.obj --ref-spp 2048 --max-spp 128
+chart CornellBox-Water scenes/cornell-box/CornellBox-Water.obj --ref-spp 2048 --max-spp 128
+veach=${FREDHOLM_SCENES:-}/veach-mis/veach_mis.obj
+if [ -n "${FREDHOLM_SCENES:-}" ] && [ -f "$veach" ]; then
+  chart veach_mis "$veach" --width 192 --height 128 --ref-spp 2048 --max-spp 128
 else
-  echo "($shared not found: the archive's scenes are left out)"
+  echo "(FREDHOLM_SCENES names no folder with veach-mis/veach_mis.obj: Veach's scene is left out)"
 fi
 /usr/bin/python3 bench/converge_table.py bench/results/convergence

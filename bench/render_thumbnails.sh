@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# Renders the README's thumbnails of the shared scenes (../shared/scenes) into
+# Renders the README's thumbnails of the scenes in $FREDHOLM_SCENES (the archive's scenes) into
 # bench/results/thumbnails/, small and with enough samples to judge the materials.
 # usage: bench/render_thumbnails.sh [SPP]   (run after ./setup.sh build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 spp=${1:-256}
-scenes=${FREDHOLM_SCENES:-../shared/scenes}
+scenes=${FREDHOLM_SCENES:?set FREDHOLM_SCENES to the folder of the archive scenes}
 out=bench/results/thumbnails
 mkdir -p "$out"
 render() {  # name obj width height [extra flags]

@@ -8,7 +8,7 @@ only interleaved figures compare).
                           -- render flags...
 
 Scenes are the CPU-speed set by default (the bunny-in-box, Sponza under a white sky, the
-water box and Veach's scene, from ../shared/scenes) or --scenes PATH[,PATH...]. Every
+water box and Veach's scene, from the folder $FREDHOLM_SCENES names) or --scenes PATH[,PATH...]. Every
 scene is rendered once by each runner as a warm-up (kernel compilation), then --rounds
 times with the runners' order rotated each round. Prints samples/s (--stats) per round,
 the medians and each runner's median ratio to the first.
@@ -17,14 +17,21 @@ import argparse, os, statistics, tempfile
 
 import benchlib
 
-SHARED = os.path.join(benchlib.ROOT, "..", "shared", "scenes")
 DEFAULT_SCENES = [("bunny-box", ["bunny/CornellBox-Bunny.obj"]), ("sponza", ["sponza/sponza.obj", "--env", "1,1,1"]),
                   ("water", ["cornell-box/CornellBox-Water.obj"]), ("veach", ["veach-mis/veach_mis.obj"])]
 
 
+def scenes_folder():
+    """The folder of the larger scenes (they do not ship): $FREDHOLM_SCENES."""
+    folder = os.environ.get("FREDHOLM_SCENES", "")
+    if not folder:
+        raise benchlib.BenchError("the default scenes need FREDHOLM_SCENES (their folder), or pass --scenes")
+    return folder
+
+
 def render(binary, strategy, scene, flags, workdir):
     choice = ["--strategy", strategy] if strategy else []
-    stats = benchlib.render([os.path.join(SHARED, scene[0])] + scene[1:] + flags + choice,
+    stats = benchlib.render([os.path.join(scenes_folder(), scene[0])] + scene[1:] + flags + choice,
                             os.path.join(workdir, "f.pfm"), binary, stats=os.path.join(workdir, "s.json"))
     return stats["samples_per_second"] / 1e6
 

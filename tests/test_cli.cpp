@@ -223,6 +223,13 @@ TEST(BenchCli, AnUnreadableSceneIsOneLineBeforeAnyMeasurement) {
     EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << scenes << ": " << r.output;
     EXPECT_FALSE(std::filesystem::exists(dir + "/b.json")) << scenes;
   }
+  // Without FREDHOLM_SCENES the larger scenes are nowhere: the build points at no folder.
+  const auto r = test::runFredholm("bench cornell sponza --width 8 --height 8 --repeats 1", "FREDHOLM_SCENES=");
+  EXPECT_EQ(r.exitCode, 1) << r.output;
+  EXPECT_NE(r.output.find("fredholm: error: bench scene 'sponza' needs FREDHOLM_SCENES, the folder that holds "
+                          "sponza/sponza.obj"),
+            std::string::npos)
+      << r.output;
 }
 
 TEST(RenderCli, ProgressLinesWhenNotATerminal) {

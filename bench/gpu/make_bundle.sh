@@ -29,9 +29,9 @@ for lib in libdl.so.2 libpthread.so.0 librt.so.1 libgcc_s.so.1; do
   cp -L "/lib/x86_64-linux-gnu/$lib" "$bundle/lib/"
 done
 
-shared=../shared/scenes
+# The larger bench scenes, where FREDHOLM_SCENES names their folder (they do not ship).
 for scene in bunny sponza; do
-  [ -d "$shared/$scene" ] && cp -r "$shared/$scene" "$bundle/scenes/"
+  [ -n "${FREDHOLM_SCENES:-}" ] && [ -d "$FREDHOLM_SCENES/$scene" ] && cp -r "$FREDHOLM_SCENES/$scene" "$bundle/scenes/"
 done
 
 # The CPU side of the GPU/CPU comparison, rendered here on PoCL with the full build

@@ -53,7 +53,7 @@ fi
 
 # ---- Ray casting, the wavefront sweep, the 1.1M-triangle scene -------------------------
 bench_scenes=(cornell)
-if [ -n "${FREDHOLM_SCENES:-}" ] || [ -d "$here/../../../shared/scenes" ]; then
+if [ -n "${FREDHOLM_SCENES:-}" ] && [ -f "$FREDHOLM_SCENES/sponza/sponza.obj" ] && [ -f "$FREDHOLM_SCENES/bunny/CornellBox-Bunny.obj" ]; then
   bench_scenes=(cornell bunny-box sponza bunnies-1m)
 fi
 fh 900 bench "${bench_scenes[@]}" --device "$gpu" --width $bench_size --height $bench_size --repeats $repeats \

@@ -285,7 +285,11 @@ int runBench(const BenchOptions& o) {
   plan.reserve();
   if (o.repeats < 1 || o.width < 1 || o.height < 1) throw Error("--repeats/--width/--height must be positive");
   std::vector<std::string> scenes = o.scenes;
-  if (scenes.empty()) scenes = {"cornell", "bunny-box", "sponza", "bunnies-1m"};
+  // By default the scenes this machine has: the built-in box and a generated million
+  // triangles, and where FREDHOLM_SCENES names their folder, the larger scenes as well.
+  if (scenes.empty())
+    scenes = sharedScenesDir().empty() ? std::vector<std::string>{"cornell", "spheres:1e6"}
+                                       : std::vector<std::string>{"cornell", "bunny-box", "sponza", "bunnies-1m"};
   for (const std::string& spec : scenes) checkBenchScene(spec);
 
   const std::vector<DeviceInfo> devices = selectDevices(listDevices(), o.device);

@@ -150,7 +150,10 @@ void checkBenchScene(const std::string& spec) {
     return;
   }
   if (const std::string rel = sharedFileOf(spec); !rel.empty()) {
-    const std::string path = sharedScenesDir() + "/" + rel;
+    const std::string dir = sharedScenesDir();
+    if (dir.empty())
+      throw Error("bench scene '" + spec + "' needs FREDHOLM_SCENES, the folder that holds " + rel);
+    const std::string path = dir + "/" + rel;
     if (!fs::exists(path)) throw Error("bench scene '" + spec + "' needs " + path + " (set FREDHOLM_SCENES)");
     return;
   }
@@ -170,8 +173,8 @@ Scene benchScene(const std::string& spec, std::string& name) {
 }
 
 std::string sharedScenesDir() {
-  if (const char* env = std::getenv("FREDHOLM_SCENES"); env && *env) return env;
-  return FREDHOLM_SHARED_SCENES_DIR;
+  const char* env = std::getenv("FREDHOLM_SCENES");
+  return env ? env : "";
 }
 
 }  // namespace fh

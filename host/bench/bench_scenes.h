@@ -15,8 +15,8 @@ Scene benchScene(const std::string& spec, std::string& name);
 // can refuse before it measures.
 void checkBenchScene(const std::string& spec);
 
-// The directory of the shared test scenes: $FREDHOLM_SCENES, else ../shared/scenes
-// beside the source tree.
+// The directory of the larger bench scenes, which do not ship (their licences or sizes):
+// $FREDHOLM_SCENES, else "" (none).
 std::string sharedScenesDir();
 
 // A scene without emitters (Sponza) gets a stand-in light so shadow rays can be timed.
