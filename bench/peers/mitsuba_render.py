@@ -283,8 +283,9 @@ def main():
     translated = {}
     for k, (name, (positions, normals, faces)) in enumerate(meshes.items()):
         m = materials.get(name)
-        if m is None:
-            fail(f"{args.scene}: material {name!r} is in no mtllib")
+        if m is None:  # fredholm warns and gives its faces the default grey diffuse
+            print(f"mitsuba_render: warning: material {name!r} is in no mtllib: grey diffuse", file=sys.stderr)
+            m = {"Kd": [0.5] * 3, "Ks": [0.0] * 3, "Ke": [0.0] * 3, "Tf": [1.0] * 3, "Ns": 0.0, "Ni": 0.0, "illum": 2}
         bsdf, translated[name] = translate(m)
         path = os.path.join(folder.name, f"mesh{k}.ply")
         write_ply(path, positions, normals, faces)
