@@ -1,8 +1,9 @@
 // The shadow-connect stage: next-event estimation for each light-sample request that
-// shade queued. Picks a light in proportion to its power: an emissive triangle and a point
-// on it (uniform in the solid angle it subtends, or in area: lights.h), or with FH_ENV_MAP
-// the environment map and a direction from it (environment.h); traces the shadow ray
-// (V(x,y)), and adds the unoccluded contribution, weighted against BSDF sampling for mis.
+// shade queued. Picks a light by the host's light table (device_scene.h): an emissive
+// triangle and a point on it (uniform in the solid angle it subtends, or in area:
+// lights.h), or with FH_ENV_MAP the environment map and a direction from it
+// (environment.h); traces the shadow ray (V(x,y)), and adds the unoccluded contribution,
+// weighted against BSDF sampling for mis.
 // Each work-item connects FH_LANES consecutive requests (lanes.h); their shadow rays are
 // traced one after the other.
 // The stage's functions; kernels/shadow_connect.cl holds its kernel, and the megakernel calls them.
@@ -31,7 +32,7 @@ typedef struct {
   lfloat shadow_distance;
 } LightSample;
 
-// A point on an emissive triangle picked in proportion to power: uniform in the solid
+// A point on an emissive triangle picked by the light table: uniform in the solid
 // angle it subtends where light_seen_from chooses that, else uniform in area.
 FH_INLINE LightSample sample_light_triangle(lvec3 origin, lfloat u_pick, lvec2 u, __global const float4* triangles,
                                             __global const int* triangle_material,

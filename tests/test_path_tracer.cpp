@@ -18,6 +18,8 @@
 #include <vector>
 #include <nlohmann/json.hpp>
 
+#include "accel/bvh.h"
+#include "render/device_scene.h"
 #include "render/pixel_filter.h"
 #include "render/render.h"
 #include "scene/closed_form.h"
@@ -701,6 +703,94 @@ TEST(WhereMethodsFail, TinyBrightLight) {
   const double ePt = squaredError(pt.film), eNee = squaredError(nee.film), eMis = squaredError(mis.film);
   EXPECT_LT(eMis, 1.5 * std::min(ePt, eNee)) << "pt " << ePt << " nee " << eNee << " mis " << eMis;
   EXPECT_GT(ePt, 10 * eNee) << "pt " << ePt << " nee " << eNee;  // the failure this scene is for
+}
+
+// Lights of very unequal power (a bright panel high above, three small lights near the
+// plane, as in Veach's scene): the light table gives each triangle half its share of the
+// power plus half of a uniform share, written out here independently, and the densities
+// it hands mis (P(triangle) / area) are the same picks.
+Scene unequalLights(std::vector<std::vector<float3>>* quads, std::vector<float>* radiance) {
+  SceneBuilder b;
+  b.quad({-5, 0, -5}, {-5, 0, 5}, {5, 0, 5}, {5, 0, -5}, b.material(0.5f));
+  *quads = {{{-1, 4, -1}, {1, 4, -1}, {1, 4, 1}, {-1, 4, 1}}};
+  *radiance = {10.f};
+  for (float x : {-1.f, 0.f, 1.f}) {
+    const float half = 0.02f;
+    quads->push_back({{x - half, 0.5f, -half}, {x + half, 0.5f, -half}, {x + half, 0.5f, half}, {x - half, 0.5f, half}});
+    radiance->push_back(25.f);
+  }
+  for (size_t i = 0; i < quads->size(); ++i) {
+    const auto& q = (*quads)[i];
+    b.quad(q[0], q[1], q[2], q[3], b.material(0.f, (*radiance)[i]));
+  }
+  return b.build();
+}
+
+TEST(LightPicking, HalfByPowerHalfUniform) {
+  std::vector<std::vector<float3>> quads;
+  std::vector<float> radiance;
+  const Scene scene = unequalLights(&quads, &radiance);
+  const Bvh bvh = buildBvh(scene);
+  const LightTable table = buildLightTable(scene, bvh);
+  // Every emitter triangle is half of a quad: its power pi * area * Le.
+  std::vector<double> power;
+  double total = 0;
+  for (size_t i = 0; i < quads.size(); ++i)
+    for (int t = 0; t < 2; ++t) {
+      const double side = double(quads[i][1][0] - quads[i][0][0]);
+      power.push_back(M_PI * 0.5 * side * side * radiance[i]);
+      total += power.back();
+    }
+  ASSERT_EQ(table.cdf.size(), power.size());
+  double below = 0, densitySum = 0;
+  for (size_t i = 0; i < power.size(); ++i) {
+    const double expected = 0.5 * power[i] / total + 0.5 / double(power.size());
+    EXPECT_NEAR(table.cdf[i] - below, expected, 1e-6) << "triangle " << i;
+    below = table.cdf[i];
+    densitySum += double(table.pdfArea[size_t(table.triangle[i])]) * scene.lights[i].area;
+  }
+  EXPECT_FLOAT_EQ(float(below), 1.f);
+  EXPECT_NEAR(densitySum, 1.0, 1e-5);
+}
+
+// The same scene rendered: the plane's radiance is Lambert's formula summed over the four
+// lights, for nee and mis, whatever the picking.
+TEST(LightPicking, UnequalLightsMatchLambertsFormula) {
+  std::vector<std::vector<float3>> quads;
+  std::vector<float> radiance;
+  const Scene scene = unequalLights(&quads, &radiance);
+  Camera camera;
+  camera.eye = {0.f, 2.f, 4.f};
+  camera.target = {0.f, 0.f, 0.f};
+  camera.fovYDeg = 50.f;
+  const int size = 16;
+  const CameraFrame f = makeCameraFrame(camera, size, size);
+  auto expected = [&](size_t p) {
+    double sum = 0;
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i) {
+        const float3 d = normalize(cameraRayDirection(f, float(p % size) + (i + 0.5f) / 4,
+                                                      float(p / size) + (j + 0.5f) / 4, size, size));
+        if (d[1] >= 0.f) return double(NAN);
+        const float3 x = camera.eye + d * (-camera.eye[1] / d[1]);
+        if (std::fabs(x[0]) > 5.f || std::fabs(x[2]) > 5.f) return double(NAN);
+        // Pixels whose footprint runs under a small light see its back (black): skipped.
+        for (size_t l = 1; l < quads.size(); ++l)
+          if (std::fabs(x[0] - quads[l][0][0] - 0.02f) < 0.3f && std::fabs(x[2]) < 0.3f) return double(NAN);
+        for (size_t l = 0; l < quads.size(); ++l) sum += 0.5 / M_PI * lambertIrradiance(x, {0, 1, 0}, quads[l], radiance[l]);
+      }
+    return sum / 16;
+  };
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = size;
+  s.spp = 256;
+  for (Method m : {Method::NEE, Method::MIS}) {
+    s.method = m;
+    s.seed = 31 + int(m);
+    const RenderResult r = test::render(scene, camera, s);
+    EXPECT_EQ(r.stats.nonfinite, 0u);
+    expectMatches(r.film, expected, methodName(m));
+  }
 }
 
 // Caustics through glass (scenes/failure/caustic.obj): a ball lens focuses a small light on

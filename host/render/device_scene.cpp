@@ -49,13 +49,19 @@ LightTable buildLightTable(const Scene& scene, const Bvh& bvh, const Environment
     total += p;
   }
   table.environmentPick = total > 0.0 ? float(environmentPower / total) : 0.f;
-  double running = environmentPower;
+  // Among the triangles, half the picks go by power and half uniformly (a defensive
+  // mixture, Hesterberg 1995): by power alone, a few small lights beside a bright one are
+  // almost never picked, and the surfaces that mirror them are lit by BSDF samples alone,
+  // with fireflies; the mixture costs power sampling at most twice its variance.
+  const double trianglePower = total - environmentPower, trianglesPick = 1.0 - double(table.environmentPick);
+  double running = double(table.environmentPick);
   size_t i = 0;
   for (const Light& l : scene.lights) {
     if (!(luminance(l.power) > 0.f)) continue;
-    running += power[i];
-    table.cdf.push_back(float(running / total));
-    table.pdfArea[size_t(table.triangle[i])] = float(power[i] / total / l.area);
+    const double pick = trianglesPick * (0.5 * power[i] / trianglePower + 0.5 / double(power.size()));
+    running += pick;
+    table.cdf.push_back(float(running));
+    table.pdfArea[size_t(table.triangle[i])] = float(pick / l.area);
     ++i;
   }
   if (!table.cdf.empty()) table.cdf.back() = 1.f;  // no rounding gap at the top

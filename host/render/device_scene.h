@@ -11,8 +11,9 @@
 
 namespace fh {
 
-// Lights chosen in proportion to power: the environment map with probability
-// environmentPick, else emissive triangle i (BVH-order triangle triangle[i]) with
+// Lights chosen by power: the environment map with probability environmentPick (its share
+// of the power), else a triangle, half of those picks in proportion to power and half
+// uniformly: emissive triangle i (BVH-order triangle triangle[i]) with
 // probability cdf[i] - cdf[i-1] (cdf[-1] being environmentPick). pdfArea[t] is, per
 // BVH-order triangle, P(pick t) / area(t) (zero for non-emitters), the density light
 // sampling gives each point of t, which mis needs when BSDF sampling hits an emitter.
