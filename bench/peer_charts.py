@@ -92,22 +92,17 @@ def chart_scene(opts, key, obj, workdir, rows):
     names = list(runners)
     for name in names:  # warm-ups: kernel compilation, JIT
         runners[name](1, 7, os.path.join(workdir, "warm.exr"))
+    def measure(name, spp):
+        def go(r):
+            image, seconds = runners[name](spp, 100 * (r + 1) + spp, os.path.join(workdir, "img.exr"))
+            error = benchlib.compare(image, references[name], opts.binary)["relmse"]
+            row = (key, name, spp, r + 1, seconds, error, "own" if references[name] != reference else "common")
+            print(*row, flush=True)
+            rows.append(row)
+        return go
+
     for spp in opts.spp:
-        def run(name):
-            return lambda r: runners[name](spp, 100 * (r + 1) + spp, os.path.join(workdir, "img.exr"))
-
-        def measure(name):
-            inner = run(name)
-
-            def go(r):
-                image, seconds = inner(r)
-                error = benchlib.compare(image, references[name], opts.binary)["relmse"]
-                row = (key, name, spp, r + 1, seconds, error, "own" if references[name] != reference else "common")
-                print(*row, flush=True)
-                rows.append(row)
-            return go
-
-        benchlib.alternate({name: measure(name) for name in names}, opts.rounds, warmup=False)
+        benchlib.alternate({name: measure(name, spp) for name in names}, opts.rounds, warmup=False)
 
 
 def plot(rows, opts, titles):

@@ -647,6 +647,27 @@ TEST(WhereMethodsFail, NoLightsIsBlackAndCameraInsideAnObjectIsFinite) {
   }
 }
 
+// A pixel's expected value on the 10 x 10 floor plane y = 0 (NaN: skip the pixel): the mean
+// of radianceAt over 4 x 4 points of the pixel where their camera rays meet the floor; NaN
+// where one of them misses it (sky, past the edge) or radianceAt says NaN.
+std::function<double(size_t)> floorPixels(const Camera& camera, int size,
+                                          std::function<double(const float3&)> radianceAt) {
+  const CameraFrame f = makeCameraFrame(camera, size, size);
+  return [=](size_t p) {
+    double sum = 0;
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i) {
+        const float3 d = normalize(cameraRayDirection(f, float(p % size) + (i + 0.5f) / 4,
+                                                      float(p / size) + (j + 0.5f) / 4, size, size));
+        if (d[1] >= 0.f) return double(NAN);
+        const float3 x = camera.eye + d * (-camera.eye[1] / d[1]);
+        if (std::fabs(x[0]) > 5.f || std::fabs(x[2]) > 5.f) return double(NAN);
+        sum += radianceAt(x);
+      }
+    return sum / 16;
+  };
+}
+
 // A tiny, bright light over a plane (Lambert's formula again): BRDF sampling almost never
 // finds it, so pt is far noisier; mis must stay within 1.5x of nee's variance.
 TEST(WhereMethodsFail, TinyBrightLight) {
@@ -676,20 +697,9 @@ TEST(WhereMethodsFail, TinyBrightLight) {
   for (const RenderResult* r : {&pt, &nee, &mis}) EXPECT_EQ(r->stats.nonfinite, 0u);
   // nee and mis converge to Lambert's value on the plane (the light itself is too small
   // to cover a pixel, and pixels that see it or the plane's edge are skipped).
-  const CameraFrame f = makeCameraFrame(camera, size, size);
-  auto expected = [&](size_t p) {
-    double sum = 0;
-    for (int j = 0; j < 4; ++j)
-      for (int i = 0; i < 4; ++i) {
-        const float3 d = normalize(cameraRayDirection(f, float(p % size) + (i + 0.5f) / 4,
-                                                      float(p / size) + (j + 0.5f) / 4, size, size));
-        if (d[1] >= 0.f) return double(NAN);
-        const float3 x = camera.eye + d * (-camera.eye[1] / d[1]);
-        if (std::fabs(x[0]) > 5.f || std::fabs(x[2]) > 5.f) return double(NAN);
-        sum += rho / M_PI * lambertIrradiance(x, {0, 1, 0}, light, le);
-      }
-    return sum / 16;
-  };
+  const auto expected = floorPixels(camera, size, [&](const float3& x) {
+    return rho / M_PI * lambertIrradiance(x, {0, 1, 0}, light, le);
+  });
   expectMatches(nee.film, expected, "nee");
   expectMatches(mis.film, expected, "mis");
   // Squared error against the exact image (pt's own variance estimate is useless here: most
@@ -764,23 +774,14 @@ TEST(LightPicking, UnequalLightsMatchLambertsFormula) {
   camera.target = {0.f, 0.f, 0.f};
   camera.fovYDeg = 50.f;
   const int size = 16;
-  const CameraFrame f = makeCameraFrame(camera, size, size);
-  auto expected = [&](size_t p) {
+  const auto expected = floorPixels(camera, size, [&](const float3& x) {
+    // Pixels whose footprint runs under a small light see its back (black): skipped.
+    for (size_t l = 1; l < quads.size(); ++l)
+      if (std::fabs(x[0] - quads[l][0][0] - 0.02f) < 0.3f && std::fabs(x[2]) < 0.3f) return double(NAN);
     double sum = 0;
-    for (int j = 0; j < 4; ++j)
-      for (int i = 0; i < 4; ++i) {
-        const float3 d = normalize(cameraRayDirection(f, float(p % size) + (i + 0.5f) / 4,
-                                                      float(p / size) + (j + 0.5f) / 4, size, size));
-        if (d[1] >= 0.f) return double(NAN);
-        const float3 x = camera.eye + d * (-camera.eye[1] / d[1]);
-        if (std::fabs(x[0]) > 5.f || std::fabs(x[2]) > 5.f) return double(NAN);
-        // Pixels whose footprint runs under a small light see its back (black): skipped.
-        for (size_t l = 1; l < quads.size(); ++l)
-          if (std::fabs(x[0] - quads[l][0][0] - 0.02f) < 0.3f && std::fabs(x[2]) < 0.3f) return double(NAN);
-        for (size_t l = 0; l < quads.size(); ++l) sum += 0.5 / M_PI * lambertIrradiance(x, {0, 1, 0}, quads[l], radiance[l]);
-      }
-    return sum / 16;
-  };
+    for (size_t l = 0; l < quads.size(); ++l) sum += 0.5 / M_PI * lambertIrradiance(x, {0, 1, 0}, quads[l], radiance[l]);
+    return sum;
+  });
   RenderSettings s = test::renderSettings();
   s.width = s.height = size;
   s.spp = 256;
