@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <condition_variable>
 #include <cstring>
 #include <map>
 #include <mutex>
@@ -54,6 +55,12 @@ class Receiver {
     if (listener_ >= 0) close(listener_);
   }
   std::string address() const { return "127.0.0.1:" + std::to_string(port_); }
+  // Waits until the sender has closed a connection and every packet on it is applied: what the
+  // sender wrote may still be in the socket after it closed. False after ten seconds.
+  bool waitForTheSenderToClose() {
+    std::unique_lock<std::mutex> lock(mutex);
+    return closed_.wait_for(lock, std::chrono::seconds(10), [&] { return connectionsEnded_ > 0; });
+  }
 
   std::mutex mutex;
   std::map<std::string, ViewerImage> images;
@@ -79,6 +86,11 @@ class Receiver {
         continue;
       }
       const ssize_t n = recv(fd, chunk, sizeof(chunk), 0);
+      if (n == 0) {  // the sender closed, and everything it sent is applied
+        std::lock_guard<std::mutex> lock(mutex);
+        ++connectionsEnded_;
+        closed_.notify_all();
+      }
       if (n <= 0) break;
       buffer.append(chunk, size_t(n));
       while (buffer.size() >= 4) {
@@ -155,6 +167,8 @@ class Receiver {
 
   int listener_ = -1, port_ = 0;
   const int closeAfter_;
+  std::condition_variable closed_;
+  int connectionsEnded_ = 0;  // under mutex
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };
@@ -182,7 +196,7 @@ TEST(LiveView, StreamsFramesAndEndsWithTheWrittenImage) {
                                    " --display-server " + viewer.address());
   ASSERT_EQ(r.exitCode, 0) << r.output;
   EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the last packets in flight
+  ASSERT_TRUE(viewer.waitForTheSenderToClose());
   std::lock_guard<std::mutex> lock(viewer.mutex);
   ASSERT_EQ(viewer.images.count(out), 1u) << "tev's image is named after the output";
   const ViewerImage& shown = viewer.images.at(out);
@@ -248,6 +262,7 @@ TEST(LiveView, InProcessFramesFollowTheFilmAndTheFinalImageIsLast) {
     final = film.image();
     view.showFinal(final);
   }  // the view closes once the final image is sent
+  ASSERT_TRUE(viewer.waitForTheSenderToClose());
   std::lock_guard<std::mutex> lock(viewer.mutex);
   EXPECT_GE(offered, 2);
   EXPECT_LE(offered, int(seconds / 0.25) + 1) << "frames at most four a second, in " << seconds << " s";
