@@ -5,6 +5,10 @@
 //   BSDF sample   -> the next direction, throughput update, Russian roulette, requeue.
 // Build options choose the method: FH_METHOD_PT, FH_METHOD_NEE or FH_METHOD_MIS. Each
 // work-item shades FH_LANES consecutive paths of the queue (lanes.h).
+// FH_LIGHT_TRACED_FIRST_VERTEX (--method lt, with FH_METHOD_MIS): light tracing
+// (light_trace.cl) counts every path whose first vertex from the camera scatters through a
+// smooth lobe or emits; the camera's paths count only those that leave the first vertex by
+// a delta lobe (a mirror, glass), which the light tracer cannot connect to the camera.
 // The stage's functions; kernels/shade.cl holds its kernel, and the megakernel calls them.
 #ifndef FH_SHADE_STAGE_H
 #define FH_SHADE_STAGE_H
@@ -137,9 +141,12 @@ FH_INLINE void add_emission(const SceneView* scene, luint p, lmask hits, const P
                             lvec3* gathered FH_PATH_PARAMS) {
   const lmask emits = hits && sh->cos_front > 0.0f && v3_any_positive(sh->material.ke);
   if (!lanes_any(emits)) return;
-  const lfloat weight = emission_weight(at->bounce, gather_float(ray_pdf, p), scene->triangles, sh->triangle,
-                                        gather_float(scene->light_pdf_area, las_uint(sh->triangle)),
-                                        gather_xyz(ray_org, p), at->hit.x * at->hit.x, sh->cos_front);
+  lfloat weight = emission_weight(at->bounce, gather_float(ray_pdf, p), scene->triangles, sh->triangle,
+                                  gather_float(scene->light_pdf_area, las_uint(sh->triangle)),
+                                  gather_xyz(ray_org, p), at->hit.x * at->hit.x, sh->cos_front);
+#if defined(FH_LIGHT_TRACED_FIRST_VERTEX)
+  weight = select(weight, (lfloat)(0.0f), at->bounce == 0);  // the light tracer sees emitters
+#endif
   *gathered = v3_select(emits, v3_add(*gathered, v3_scale(v3_mul(at->beta, sh->material.ke), weight)), *gathered);
 }
 
@@ -152,6 +159,9 @@ FH_INLINE void request_light_sample(RenderParams params, lmask may_bounce, const
   ShadowRequest* r = &o->request;
   o->light_sample =
       may_bounce && (params.light_count > 0 || params.env_pick > 0.0f) && bsdf_has_smooth_lobe(&sh->bsdf);
+#if defined(FH_LIGHT_TRACED_FIRST_VERTEX)
+  o->light_sample = o->light_sample && at->bounce > 0;  // the light tracer connects the first vertex
+#endif
   r->at.position = sh->point.position;
   r->at.magnitude = sh->point.magnitude;
   r->at.normal = v3_select(front, sh->point.normal, v3_neg(sh->point.normal));
@@ -178,6 +188,9 @@ FH_INLINE lmask bounce_and_roulette(RenderParams params, luint p, lmask may_boun
                                    sample_1d(&sampler, dim + FH_DIM_BSDF_LOBE), u.x, u.y);
   lvec3 beta = v3_mul(at->beta, b.weight);
   lmask continues = may_bounce && b.pdf != 0.0f;
+#if defined(FH_LIGHT_TRACED_FIRST_VERTEX)
+  continues = continues && (at->bounce > 0 || b.pdf < 0.0f);  // smooth lobes at the first vertex: light traced
+#endif
   const lmask roulette = continues && at->bounce + 1 >= params.rr_depth;
   if (lanes_any(roulette)) {
     const lfloat survive = fmin(v3_max_component(beta), 0.95f);

@@ -2,6 +2,7 @@
 
 #include "bench/ray_workload.h"
 #include "kernels/path_state.h"
+#include "render/light_tracer.h"
 #include "render/render_aov.h"
 #include "render/wavefront.h"
 
@@ -32,6 +33,12 @@ std::vector<ProgramSpec> everyProgramVariant() {
   for (Strategy strategy : {Strategy::Scalar, Strategy::Megakernel8})
     for (const SceneFeatures& features : {SceneFeatures{}, SceneFeatures::all()})
       programs.push_back(pathTracerProgram(features, Method::PT, traversal, strategy, true));
+  // Light tracing (--method lt): its kernel for every material feature, and its camera
+  // paths (mis keeping those that leave the first vertex by a delta lobe) with glass and mirrors.
+  for (unsigned bits = 0; bits < 16; ++bits)
+    programs.push_back(lightTracerProgram({(bits & 1) != 0, (bits & 2) != 0, (bits & 4) != 0, (bits & 8) != 0}, traversal));
+  for (Strategy strategy : {Strategy::Scalar, Strategy::Simd8, Strategy::Megakernel8})
+    programs.push_back(pathTracerProgram(SceneFeatures::all(), Method::LT, traversal, strategy));
   return programs;
 }
 

@@ -18,6 +18,22 @@ class SceneBuilder {
     return int(scene_.materials.size() - 1);
   }
 
+  // A smooth dielectric of index `ni` (illum 7): the medium lies behind its faces' fronts.
+  int glass(float ni) {
+    const int m = material(0.f);
+    scene_.materials[size_t(m)].illum = 7;
+    scene_.materials[size_t(m)].ni = ni;
+    return m;
+  }
+
+  // Triangle a b c, counter-clockwise as seen from its front.
+  void triangle(const float3& a, const float3& b, const float3& c, int material) {
+    const unsigned base = unsigned(scene_.vertexCount());
+    for (const float3& p : {a, b, c}) scene_.positions.insert(scene_.positions.end(), p.begin(), p.end());
+    for (unsigned k : {0u, 1u, 2u}) scene_.indices.push_back(base + k);
+    scene_.triangleMaterial.push_back(material);
+  }
+
   // Quad a b c d, counter-clockwise as seen from its front.
   void quad(const float3& a, const float3& b, const float3& c, const float3& d, int material) {
     const unsigned base = unsigned(scene_.vertexCount());

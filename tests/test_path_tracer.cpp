@@ -107,9 +107,10 @@ Camera insideCamera() {
   return c;
 }
 
-TEST_P(EveryMethod, ClosedFurnaceBoxIsLeOverOneMinusRho) {
+// The closed furnace for `method`.
+void expectClosedFurnace(Method method) {
   RenderSettings s = test::renderSettings();
-  s.method = GetParam();
+  s.method = method;
   s.width = s.height = 16;
   s.spp = 256;
   for (const float rho : {0.5f, 0.8f}) {
@@ -121,9 +122,11 @@ TEST_P(EveryMethod, ClosedFurnaceBoxIsLeOverOneMinusRho) {
     EXPECT_EQ(r.stats.nonfinite, 0u);
     EXPECT_EQ(r.stats.samples, 16u * 16u * 256u);
     expectMatches(r.film, [&](size_t) { return le / (1.0 - rho); },
-                  std::string(methodName(GetParam())) + ", rho " + std::to_string(rho));
+                  std::string(methodName(method)) + ", rho " + std::to_string(rho));
   }
 }
+
+TEST_P(EveryMethod, ClosedFurnaceBoxIsLeOverOneMinusRho) { expectClosedFurnace(GetParam()); }
 
 // Renders `scene` (the plane under a light, perhaps with other normals) with the test's
 // method and holds it to the plane's exact image (box filter, 8x8 grid per pixel); pixels
@@ -148,7 +151,7 @@ TEST_P(EveryMethod, PlaneUnderRectangularEmitterFollowsLambertsFormula) {
 // plane and the emitter, given normals pointing away from their fronts, still follow
 // Lambert's formula (not turned, the plane would reflect nothing). The emitter still emits
 // from its counter-clockwise side only.
-TEST_P(EveryMethod, VertexNormalsAgainstTheWindingShadeLikeFlatFaces) {
+Scene planeWithNormalsAgainstTheWinding() {
   Scene scene = PlaneUnderLight::scene();
   scene.cornerNormals.clear();
   for (size_t t = 0; t < scene.triangleCount(); ++t) {
@@ -156,7 +159,12 @@ TEST_P(EveryMethod, VertexNormalsAgainstTheWindingShadeLikeFlatFaces) {
     const Vec3f against = normalize(cross(c - a, b - a));  // the front is cross(b - a, c - a)
     for (int k = 0; k < 3; ++k) scene.cornerNormals.insert(scene.cornerNormals.end(), against.begin(), against.end());
   }
-  expectLambertsPlane(scene, GetParam(), std::string(methodName(GetParam())) + ", normals against the winding");
+  return scene;
+}
+
+TEST_P(EveryMethod, VertexNormalsAgainstTheWindingShadeLikeFlatFaces) {
+  expectLambertsPlane(planeWithNormalsAgainstTheWinding(), GetParam(),
+                      std::string(methodName(GetParam())) + ", normals against the winding");
 }
 
 // Adaptive sampling keeps each pixel its own mean: the same closed form holds where pixels
@@ -864,6 +872,124 @@ TEST(WhereMethodsFail, GrazingAngles) {
     EXPECT_EQ(r.stats.nonfinite, 0u);
     expectMatches(r.film, [&](size_t p) { return double(exact.rgb[3 * p]); }, methodName(m));
   }
+}
+
+// ---- Light tracing (--method lt, render/light_tracer.h) ----
+// Light paths connected to the camera and splatted where it sees them, beside camera paths
+// for what is seen through a delta lobe: the closed forms above, and mis's image wherever
+// the adjoint differs from radiance transport (refraction's 1/eta^2, shading normals, the
+// diffuse share that depends on the outgoing direction) and under every pixel filter.
+
+TEST(LightTracing, ClosedFurnaceBoxIsLeOverOneMinusRho) { expectClosedFurnace(Method::LT); }
+
+TEST(LightTracing, PlaneUnderRectangularEmitterFollowsLambertsFormula) {
+  expectLambertsPlane(PlaneUnderLight::scene(), Method::LT, "lt");
+  expectLambertsPlane(planeWithNormalsAgainstTheWinding(), Method::LT, "lt, normals against the winding");
+}
+
+RenderResult renderWithMethod(const Scene& scene, Method method, int size, int spp, unsigned seed,
+                              PixelFilter filter = PixelFilter::Box) {
+  RenderSettings s = test::renderSettings();
+  s.method = method;
+  s.width = s.height = size;
+  s.spp = spp;
+  s.seed = seed;
+  s.filter = filter;
+  RenderResult r = test::render(scene, scene.camera, s);
+  EXPECT_EQ(r.stats.nonfinite, 0u) << methodName(method);
+  return r;
+}
+
+// Glass spheres and water (refraction, with vertex normals), a mirror sphere, and the light
+// seen through them: what the camera paths add and what the light paths splat.
+TEST(LightTracing, AgreesWithMisThroughGlassMirrorsAndVertexNormals) {
+  const Scene scene = loadScene(test::projectScene("cornell-box/CornellBox-Water.obj"));
+  const RenderResult lt = renderWithMethod(scene, Method::LT, 32, 256, 3);
+  expectAgree(lt.film, renderWithMethod(scene, Method::MIS, 32, 256, 4).film, "water box: lt vs mis", 8);
+  EXPECT_GT(lt.stats.cameraRays, 0u) << "no camera paths for what is seen through glass";
+}
+
+TEST(LightTracing, AgreesWithMisOnGlossySurfacesAndUnderEveryFilter) {
+  const Scene glossy = loadScene(test::projectScene("cornell-box/legacy-glossy-2011/CornellBox-Glossy.obj"));
+  expectAgree(renderWithMethod(glossy, Method::LT, 32, 256, 5).film,
+              renderWithMethod(glossy, Method::MIS, 32, 256, 6).film, "glossy box: lt vs mis", 8);
+  const Scene box = loadDefaultScene();
+  for (PixelFilter filter : {PixelFilter::Gaussian, PixelFilter::BlackmanHarris})
+    expectAgree(renderWithMethod(box, Method::LT, 24, 256, 7, filter).film,
+                renderWithMethod(box, Method::MIS, 24, 256, 8, filter).film,
+                std::string("Cornell box, ") + filterName(filter) + ": lt vs mis");
+}
+
+// The camera and a floor under a sheet of glass (the medium below it), the light above:
+// light paths cross one interface into the camera's medium. Radiance is scaled by eta^2 there
+// and importance is not; a light tracer that carried radiance's 1/eta^2 would see the floor
+// 2.25 times too dark. (Through a closed object the two factors cancel.)
+TEST(LightTracing, AgreesWithMisWhereLightEntersTheCamerasMedium) {
+  SceneBuilder b;
+  const float big = 20.f;
+  b.quadFacing({-big, 0, -big}, {big, 0, -big}, {big, 0, big}, {-big, 0, big}, {0, 1, 0}, b.material(0.5f));
+  b.quadFacing({-big, 1, -big}, {big, 1, -big}, {big, 1, big}, {-big, 1, big}, {0, 2, 0}, b.glass(1.5f));
+  b.quadFacing({-2, 2, -2}, {2, 2, -2}, {2, 2, 2}, {-2, 2, 2}, {0, 0, 0}, b.material(0.f, 1.f));
+  Scene scene = b.build();
+  scene.camera.eye = {0.f, 0.6f, 1.f};
+  scene.camera.target = {0.f, 0.f, 0.f};
+  scene.camera.up = {0, 1, 0};
+  scene.camera.fovYDeg = 60.f;
+  expectAgree(renderWithMethod(scene, Method::LT, 24, 256, 11).film,
+              renderWithMethod(scene, Method::MIS, 24, 256, 12).film, "floor under glass: lt vs mis");
+}
+
+// The Cornell box with every vertex normal tilted 27 degrees off its face's: light tracing
+// weighs the connection to the camera and each bounce by the shading normal's cosine at
+// the incoming side over the geometric one (Veach 1997, section 5.3), or it would light
+// the walls by their faces' normals where camera paths light them by the tilted ones.
+TEST(LightTracing, AgreesWithMisUnderTiltedVertexNormals) {
+  Scene scene = loadDefaultScene();
+  scene.cornerNormals.clear();
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    const Vec3f a = scene.corner(t, 0), b = scene.corner(t, 1), c = scene.corner(t, 2);
+    const Vec3f front = normalize(cross(b - a, c - a));
+    const Vec3f tilted = normalize(front + normalize(cross(front, Vec3f{0.3f, 0.5f, 0.8f})) * 0.5f);
+    for (int k = 0; k < 3; ++k) scene.cornerNormals.insert(scene.cornerNormals.end(), tilted.begin(), tilted.end());
+  }
+  expectAgree(renderWithMethod(scene, Method::LT, 24, 256, 13).film,
+              renderWithMethod(scene, Method::MIS, 24, 256, 14).film, "tilted normals: lt vs mis");
+}
+
+// Light grazing a floor whose vertex normals lean 40 degrees toward it: the floor sends on
+// about three times what its faces' normal would say (|ns.w_in| / |ng.w_in|), and the wall
+// it lights shows whether each bounce of a light path is weighed that way.
+TEST(LightTracing, AgreesWithMisWhereShadingNormalsLeanTowardGrazingLight) {
+  SceneBuilder b;
+  b.quadFacing({-3, 0, -3}, {3, 0, -3}, {3, 0, 3}, {-3, 0, 3}, {0, 1, 0}, b.material(0.8f));          // floor
+  b.quadFacing({-3, 0, -3}, {3, 0, -3}, {3, 3, -3}, {-3, 3, -3}, {0, 1, 0}, b.material(0.8f));         // back wall
+  b.quadFacing({-3.5f, 0.1f, -3}, {-3.5f, 0.1f, 3}, {-3.5f, 0.6f, 3}, {-3.5f, 0.6f, -3}, {0, 0.3f, 0},  // light
+               b.material(0.f, 5.f));
+  Scene scene = b.build();
+  const Vec3f leaning = normalize(Vec3f{-std::sin(0.7f), std::cos(0.7f), 0.f});
+  for (size_t t = 0; t < scene.triangleCount(); ++t) {
+    const Vec3f a = scene.corner(t, 0), c1 = scene.corner(t, 1), c2 = scene.corner(t, 2);
+    const Vec3f n = t < 2 ? leaning : normalize(cross(c1 - a, c2 - a));
+    for (int k = 0; k < 3; ++k) scene.cornerNormals.insert(scene.cornerNormals.end(), n.begin(), n.end());
+  }
+  scene.camera.eye = {1.f, 1.5f, 6.f};
+  scene.camera.target = {0.f, 1.f, -3.f};
+  scene.camera.up = {0, 1, 0};
+  scene.camera.fovYDeg = 50.f;
+  expectAgree(renderWithMethod(scene, Method::LT, 24, 256, 15).film,
+              renderWithMethod(scene, Method::MIS, 24, 256, 16).film, "leaning normals: lt vs mis");
+}
+
+// The caustic scene (a glass ball focusing a small light on the floor), where every camera
+// method finds the caustic by BSDF sampling alone: light tracing connects it from the
+// floor, so at equal samples its image variance is a fraction of mis's.
+TEST(LightTracing, RendersTheCausticWithAFractionOfMissVariance) {
+  const Scene scene = loadScene(test::projectScene("failure/caustic.obj"));
+  const RenderResult lt = renderWithMethod(scene, Method::LT, 32, 256, 9);
+  const RenderResult mis = renderWithMethod(scene, Method::MIS, 32, 256, 10);
+  expectAgree(lt.film, mis.film, "caustic: lt vs mis", 8);
+  EXPECT_LT(imageVariance(lt.film), 0.25 * imageVariance(mis.film))
+      << "variance lt " << imageVariance(lt.film) << " mis " << imageVariance(mis.film);
 }
 
 }  // namespace

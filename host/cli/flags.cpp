@@ -15,7 +15,8 @@ Method parseMethod(const std::string& name) {
   if (name == "pt") return Method::PT;
   if (name == "nee") return Method::NEE;
   if (name == "mis") return Method::MIS;
-  throw Error("--method '" + name + "': unknown method (use pt, nee or mis)");
+  if (name == "lt") return Method::LT;
+  throw Error("--method '" + name + "': unknown method (use pt, nee, mis or lt)");
 }
 
 Strategy parseStrategy(const std::string& name) {

@@ -1,5 +1,6 @@
 // `fredholm render`: flags checked before any work, then scene, camera, BVH, one render on
 // every device --device selects, and the image with its metadata.
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -108,6 +109,18 @@ void chunkOf(const RenderOptions& o, RenderSettings& s) {
   s.spp = int(end);
 }
 
+// Light tracing starts its paths on the scene's emitting triangles and splats them wherever
+// the camera sees them: what it cannot do yet is an error before any work.
+void lightTracingFits(const RenderOptions& o, const RenderSettings& s) {
+  const char* why = nullptr;
+  if (s.env != std::array<float, 3>{0.f, 0.f, 0.f}) why = "--env";
+  else if (!o.envMap.empty()) why = "--env-map";
+  else if (o.adaptive) why = "--adaptive (its passes cover chosen pixels; a light path lands anywhere)";
+  if (why)
+    throw Error(std::string("--method lt traces paths from the emitting triangles only and does not go with ") + why +
+                "; use mis");
+}
+
 // --seed: the sampler's seed is 32 bits.
 unsigned parseSeed(const std::string& text) {
   const bool digits = !text.empty() && text.size() <= 10 && text.find_first_not_of("0123456789") == std::string::npos;
@@ -125,6 +138,7 @@ RenderSettings settingsFrom(const RenderOptions& o) {
   s.filter = parseFilter(o.filter);
   if (!o.env.empty()) s.env = parseVec3Flag("--env", o.env);
   if (s.env[0] < 0 || s.env[1] < 0 || s.env[2] < 0) throw Error("--env '" + o.env + "': radiance cannot be negative");
+  if (s.method == Method::LT) lightTracingFits(o, s);  // before a map is read
   s.envMap = environmentMapFrom(o);
   if (o.width <= 0 || o.height <= 0) throw Error("--width/--height must be positive");
   // Pixels are indexed in 32 bits on the device, with room for several pass buffers.
@@ -203,6 +217,10 @@ std::vector<std::string> planOutputs(RenderOptions& o, RenderSettings& settings,
   const std::vector<std::string> layers = o.aovs.empty() ? std::vector<std::string>{} : parseAovLayers(o.aovs);
   if (!o.aov.empty() && !layers.empty()) throw Error("--aov (a debug view) and --aovs (layers beside the image): pick one");
   for (const auto& layer : layers) settings.surfaceAovs |= isSurfaceAov(layer);
+  if (settings.method == Method::LT && (settings.surfaceAovs || o.denoise))
+    throw Error("--method lt records no first surfaces, which " +
+                (settings.surfaceAovs ? "--aovs '" + o.aovs + "' asks for" : std::string("--denoise needs")) +
+                " (camera paths see them, light paths do not); use mis");
   // An explicit -o is never overwritten without --force; the default name steps aside.
   // With --film the film is the output, and an image is written only where -o asks.
   const bool defaultName = o.output.empty() && o.film.empty();

@@ -2,7 +2,7 @@
 // pipeline, queues iterations in batches, and hands each pass back as soon as it is complete.
 #pragma once
 #include "render/pass_source.h"
-#include "render/wavefront.h"
+#include "render/pass_renderer.h"
 
 namespace fh {
 
@@ -10,7 +10,7 @@ class DeviceWorker {
  public:
   // `failAfter` >= 0 simulates the device failing when it finishes that many passes
   // (FREDHOLM_FAIL_DEVICE, for tests); -1: never.
-  DeviceWorker(int index, WavefrontPipeline& pipeline, PassSource& source, long failAfter = -1)
+  DeviceWorker(int index, PassRenderer& pipeline, PassSource& source, long failAfter = -1)
       : index_(index), pipeline_(pipeline), source_(source), failAfter_(failAfter) {}
 
   // Renders until the source has nothing more for this device, or `stop` is set (passes in
@@ -24,7 +24,7 @@ class DeviceWorker {
   void returnCompletePasses();
 
   int index_;
-  WavefrontPipeline& pipeline_;
+  PassRenderer& pipeline_;
   PassSource& source_;
   long failAfter_;
   uint64_t granted_ = 0, returned_ = 0;  // local passes

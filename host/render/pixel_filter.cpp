@@ -24,10 +24,27 @@ double filterValue(PixelFilter f, double x, double radius) {
   return 1.0;
 }
 
+double filterRadius(PixelFilter filter) {
+  return filter == PixelFilter::Box ? 0.5 : filter == PixelFilter::Gaussian ? 1.5 : 2.0;
+}
+
 }  // namespace
 
+std::vector<float> filterDensity(PixelFilter filter, int size) {
+  const double r = filterRadius(filter), step = 2 * r / (size - 1);
+  std::vector<double> values(size_t(size), 0.0);
+  double integral = 0;
+  for (int i = 0; i < size; ++i) {
+    values[size_t(i)] = filterValue(filter, -r + i * step, r);
+    integral += values[size_t(i)] * (i == 0 || i == size - 1 ? 0.5 : 1.0) * step;
+  }
+  std::vector<float> table(values.size());
+  for (size_t i = 0; i < values.size(); ++i) table[i] = float(values[i] / integral);
+  return table;
+}
+
 std::vector<float> filterInverseCdf(PixelFilter filter, int size, float* radius) {
-  const double r = filter == PixelFilter::Box ? 0.5 : filter == PixelFilter::Gaussian ? 1.5 : 2.0;
+  const double r = filterRadius(filter);
   *radius = float(r);
   // Integrate the filter finely, then invert the CDF at `size` evenly spaced values.
   const int steps = 4096;

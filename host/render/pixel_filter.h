@@ -11,4 +11,9 @@ namespace fh {
 // The filter's 1D inverse CDF over [-radius, radius], `size` entries (separable filters).
 std::vector<float> filterInverseCdf(PixelFilter filter, int size, float* radius);
 
+// The filter's 1D density over [-radius, radius] at `size` evenly spaced points, scaled so
+// that its linear interpolation integrates to one: the weights light tracing splats with
+// (kernels/light_trace.cl), where a sample lands at a position rather than in a pixel.
+std::vector<float> filterDensity(PixelFilter filter, int size);
+
 }  // namespace fh

@@ -12,7 +12,9 @@
 
 #include "base/test_hooks.h"
 #include "render/device_worker.h"
+#include "render/light_tracer.h"
 #include "render/pass_pool.h"
+#include "render/wavefront.h"
 
 namespace fh {
 namespace {
@@ -92,16 +94,16 @@ class Render {
           devices_[i].context ? *devices_[i].context : *(own = std::make_unique<DeviceContext>(devices_[i].info));
       RenderSettings perDevice = settings_;
       perDevice.progress = false;  // the pool shows the render's progress
-      WavefrontPipeline pipeline(dc, scene_, bvh_, camera_, perDevice);
-      share.wavefront = pipeline.wavefront();
-      share.strategy = strategyName(pipeline.strategy());
+      const std::unique_ptr<PassRenderer> pipeline = passRenderer(dc, perDevice);
+      share.wavefront = pipeline->wavefront();
+      share.strategy = strategyName(pipeline->strategy());
       started = true;
       startLine_.arrive();
       begin = Clock::now();
-      DeviceWorker(int(i), pipeline, pool_, simulatedFailure(int(i))).run(links_);
+      DeviceWorker(int(i), *pipeline, pool_, simulatedFailure(int(i))).run(links_);
       if (links_.stopRequested()) pool_.fail(int(i));  // wakes workers waiting for its passes
       FH_CL(dc.queue.finish());
-      counts_[i] = pipeline.stats();
+      counts_[i] = pipeline->stats();
     } catch (const std::exception& e) {
       share.error = e.what();
       errors_[i] = std::current_exception();
@@ -110,6 +112,12 @@ class Render {
     }
     ends_[i] = Clock::now();
     share.busySeconds = std::chrono::duration<double>(ends_[i] - begin).count();
+  }
+
+  // The method's pipeline on one device: paths from the camera, or from the lights.
+  std::unique_ptr<PassRenderer> passRenderer(DeviceContext& dc, const RenderSettings& s) const {
+    if (s.method == Method::LT) return std::make_unique<LightTracer>(dc, scene_, bvh_, camera_, s);
+    return std::make_unique<WavefrontPipeline>(dc, scene_, bvh_, camera_, s);
   }
 
   // The film and the totals. Nothing rendered and nothing left to render on: the render

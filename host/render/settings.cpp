@@ -5,7 +5,15 @@
 
 namespace fh {
 
-const char* methodName(Method m) { return m == Method::PT ? "pt" : m == Method::NEE ? "nee" : "mis"; }
+const char* methodName(Method m) {
+  switch (m) {
+    case Method::PT: return "pt";
+    case Method::NEE: return "nee";
+    case Method::MIS: return "mis";
+    case Method::LT: return "lt";
+  }
+  return "?";
+}
 
 const char* strategyName(Strategy s) {
   switch (s) {

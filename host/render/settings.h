@@ -16,7 +16,9 @@ struct Film;
 class FilmWatcher;
 class PassLedger;
 
-enum class Method { PT, NEE, MIS };
+// pt, nee and mis trace paths from the camera (render/wavefront.h); lt traces them from the
+// lights and connects each vertex to the camera (render/light_tracer.h).
+enum class Method { PT, NEE, MIS, LT };
 const char* methodName(Method m);
 
 enum class PixelFilter { Box, Gaussian, BlackmanHarris };

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstddef>
 
+#include "render/kernel_arguments.h"
 #include "render/pixel_filter.h"
 
 namespace fh {
@@ -14,57 +15,7 @@ constexpr int kFilterTableSize = 256;
 // Passes of every pixel in flight at most (each costs a frame of pass buffers).
 constexpr size_t kMostFullPasses = 8;
 
-// Sets a kernel's arguments in the order they are given, so no call site counts indices.
-class ArgumentList {
- public:
-  explicit ArgumentList(cl::Kernel& kernel) : kernel_(kernel) {}
-  template <typename T>
-  ArgumentList& operator<<(const T& value) {
-    FH_CL(kernel_.setArg(next_++, value));
-    return *this;
-  }
-  // Every path-state field, in FH_PATH_FIELDS order: a stage's FH_PATH_PARAMS.
-  ArgumentList& operator<<(const PathStateBuffers& p) {
-#define FH_ARGUMENT(type, name, bytes) *this << p.name;
-    FH_PATH_FIELDS(FH_ARGUMENT)
-#undef FH_ARGUMENT
-    return *this;
-  }
-  // Every scene buffer, in FH_SCENE_FIELDS order: a kernel's FH_SCENE_PARAMS.
-  ArgumentList& operator<<(const SceneBuffers& b) {
-#define FH_ARGUMENT(type, name) *this << b.name;
-    FH_SCENE_FIELDS(FH_ARGUMENT)
-#undef FH_ARGUMENT
-    return *this;
-  }
-  // Every light-sample request field: FH_SHADOW_PARAMS.
-  ArgumentList& operator<<(const ShadowRequestBuffers& r) {
-#define FH_ARGUMENT(type, name, bytes) *this << r.name;
-    FH_SHADOW_FIELDS(FH_ARGUMENT)
-#undef FH_ARGUMENT
-    return *this;
-  }
-  // A list that binds fewer or more arguments than the kernel has is a bug here, caught
-  // before any launch.
-  void expectComplete(const char* what) const {
-    const cl_uint expected = kernel_.getInfo<CL_KERNEL_NUM_ARGS>();
-    if (next_ != expected)
-      throw Error(std::string("internal error: ") + what + " bound " + std::to_string(next_) + " arguments of " +
-                  std::to_string(expected));
-  }
-
- private:
-  cl::Kernel& kernel_;
-  cl_uint next_ = 0;
-};
-
-// Binds `values` to `kernel`'s parameters in order, all of them.
-template <typename... T>
-void bindAll(cl::Kernel& kernel, const char* what, const T&... values) {
-  ArgumentList list(kernel);
-  (list << ... << values);
-  list.expectComplete(what);
-}
+}  // namespace
 
 gpu::RenderParams renderParams(const RenderSettings& s, const Camera& camera, const DeviceScene& scene,
                                std::vector<float>& filterTable) {
@@ -86,8 +37,6 @@ gpu::RenderParams renderParams(const RenderSettings& s, const Camera& camera, co
   return p;
 }
 
-}  // namespace
-
 SceneFeatures featuresFor(const Scene& scene, const RenderSettings& s) {
   SceneFeatures f = s.allFeatures ? SceneFeatures::all() : sceneFeatures(scene);
   f.environmentMap = f.environmentMap || s.envMap;
@@ -96,7 +45,11 @@ SceneFeatures featuresFor(const Scene& scene, const RenderSettings& s) {
 
 ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, const std::string& traversalOptions,
                               Strategy strategy, bool surfaceAovs) {
-  const char* methodFlag = method == Method::PT ? "PT" : method == Method::NEE ? "NEE" : "MIS";
+  // Light tracing's camera paths are mis paths that leave their first vertex by a delta lobe.
+  const char* methodFlag = method == Method::PT    ? "PT"
+                           : method == Method::NEE ? "NEE"
+                           : method == Method::LT  ? "MIS -DFH_LIGHT_TRACED_FIRST_VERTEX"
+                                                   : "MIS";
   const bool mega = isMegakernel(strategy);
   return {std::string("path tracer (") + methodName(method) + features.buildOptions() + ", " + strategyName(strategy) +
               (surfaceAovs ? ", aovs" : "") + ")",
@@ -335,7 +288,7 @@ void WavefrontPipeline::startGrantedPasses() {
   writeCounter(offsetof(gpu::WavefrontCounters, sample_limit), sampleLimit_);
 }
 
-const gpu::WavefrontCounters& WavefrontPipeline::readCounters() {
+void WavefrontPipeline::readCounters() {
   FH_CL(dc_.queue.enqueueReadBuffer(queues_.counters, CL_TRUE, 0, sizeof counters_, &counters_));
   startedSamples_ += uint32_t(counters_.next_sample - uint32_t(startedSamples_));  // its low 32 bits, which wrap
   for (const auto& [kernel, event] : events_) {
@@ -345,7 +298,6 @@ const gpu::WavefrontCounters& WavefrontPipeline::readCounters() {
     stageSeconds_[kernel] += double(end - start) * 1e-9;
   }
   events_.clear();
-  return counters_;
 }
 
 bool WavefrontPipeline::passComplete(uint64_t local) const {

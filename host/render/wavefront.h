@@ -14,6 +14,7 @@
 #include "kernels/path_state.h"
 #include "render/device_scene.h"
 #include "render/film.h"
+#include "render/pass_renderer.h"
 #include "render/pass_source.h"
 #include "render/render_stats.h"
 #include "render/settings.h"
@@ -50,6 +51,11 @@ struct SlotQueues {
 ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, const std::string& traversalOptions,
                               Strategy strategy, bool surfaceAovs = false);
 
+// What every kernel of a render reads (kernels/types.h), and the pixel filter's inverse CDF
+// that camera rays are offset by.
+gpu::RenderParams renderParams(const RenderSettings& s, const Camera& camera, const DeviceScene& scene,
+                               std::vector<float>& filterTable);
+
 // The features a render's kernels are compiled with: the scene's (or all of them with
 // --all-features), and the environment map if the render has one.
 SceneFeatures featuresFor(const Scene& scene, const RenderSettings& s);
@@ -71,14 +77,14 @@ constexpr int kIterationsPerBatch = 8;
 // path state should stay near the caches; never more than two passes of pixels.
 size_t defaultWavefront(const DeviceInfo& device, size_t pixels);
 
-class WavefrontPipeline {
+class WavefrontPipeline : public PassRenderer {
  public:
   // `scene`: prepareScene(scene, bvh, featuresFor(scene, s), s.envMap), once for all devices.
   WavefrontPipeline(DeviceContext& dc, const PreparedScene& scene, const Bvh& bvh, const Camera& camera,
                     const RenderSettings& s);
 
   // One iteration over every path in flight; returns at once (the device runs it later).
-  void enqueueIteration();
+  void enqueueIteration() override;
 
   // Passes are numbered locally (0, 1, ... on this device) and mapped to global passes,
   // which seed the samples. A pass covers the pixels listed (null: every pixel, each
@@ -87,24 +93,24 @@ class WavefrontPipeline {
   // the pass buffers, and of two shapes at most (gpu::PassShape: runs of passes over one
   // pixel list): a pass of a new shape waits, held by the worker, until every sample of the
   // older one in flight has started.
-  bool fits(const std::shared_ptr<const RoundPixels>& pixels, uint64_t granted, uint64_t returned) const;
-  void grantPass(uint64_t local, uint32_t global, std::shared_ptr<const RoundPixels> pixels);
+  bool fits(const std::shared_ptr<const RoundPixels>& pixels, uint64_t granted, uint64_t returned) const override;
+  void grantPass(uint64_t local, uint32_t global, std::shared_ptr<const RoundPixels> pixels) override;
   // Lets the passes granted so far start; once per batch, after its grants.
-  void startGrantedPasses();
-  uint32_t globalPass(uint64_t local) const { return passes_[local % FH_MAX_PASS_SLOTS].table[0]; }
+  void startGrantedPasses() override;
+  uint32_t globalPass(uint64_t local) const override { return passes_[local % FH_MAX_PASS_SLOTS].table[0]; }
 
   // Waits for the queued iterations and reads the books back.
-  const gpu::WavefrontCounters& readCounters();
+  void readCounters() override;
   // Whether local pass `local` is complete, as of the last readCounters().
-  bool passComplete(uint64_t local) const;
+  bool passComplete(uint64_t local) const override;
   // Reads a complete pass's samples (rgb, 1 for each pixel it covers, in the order of its
   // pixel list; then, with surface AOVs, kAovFloatsPerPixel for each) and frees its slot.
-  void takePass(uint64_t local, std::vector<float>& samples);
+  void takePass(uint64_t local, std::vector<float>& samples) override;
 
   // This device's counts so far (samples are the film's to count) and stage times.
-  RenderStats stats();
-  size_t wavefront() const { return wavefront_; }
-  Strategy strategy() const { return strategy_; }
+  RenderStats stats() override;
+  size_t wavefront() const override { return wavefront_; }
+  Strategy strategy() const override { return strategy_; }
 
  private:
   // The stages; each launches its kernel, bound for the current parity.

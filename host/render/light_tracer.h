@@ -1,0 +1,74 @@
+// Light tracing on one device (--method lt, kernels/light_trace.cl): a pass is one light
+// path per pixel of the image, each connected to the camera at every vertex that can be,
+// its contributions splatted to the pixels they land on as whole film quanta in 64-bit
+// integers. A pass's sums are then the same bits whichever order its paths added them
+// in, so films merge exactly as the path tracer's do. A pass runs as one launch into a
+// splat buffer of its own, read back whole.
+//
+// Light paths cannot reach the camera through a delta lobe (a mirror or glass seen
+// directly): in a scene that has them, a camera pass (the path tracer's mis, keeping only
+// the paths that leave their first vertex by a delta lobe: FH_LIGHT_TRACED_FIRST_VERTEX)
+// renders the same pass beside it, and a pass's sample is the sum of the two.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "render/device_scene.h"
+#include "render/pass_renderer.h"
+#include "render/wavefront.h"
+#include "scene/camera.h"
+
+namespace fh {
+
+// The light tracer's program for a scene's features: one lane, one light path per work-item.
+ProgramSpec lightTracerProgram(const SceneFeatures& features, const std::string& traversalOptions);
+
+class LightTracer : public PassRenderer {
+ public:
+  LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bvh& bvh, const Camera& camera,
+              const RenderSettings& s);
+
+  bool fits(const std::shared_ptr<const RoundPixels>& pixels, uint64_t granted, uint64_t returned) const override;
+  void grantPass(uint64_t local, uint32_t global, std::shared_ptr<const RoundPixels> pixels) override;
+  void startGrantedPasses() override;
+  uint32_t globalPass(uint64_t local) const override { return slots_[local % kSlots].global; }
+
+  void enqueueIteration() override;
+  void readCounters() override;
+  bool passComplete(uint64_t local) const override;
+  void takePass(uint64_t local, std::vector<float>& samples) override;
+
+  RenderStats stats() override;
+  size_t wavefront() const override { return pixels_; }
+  Strategy strategy() const override { return Strategy::Scalar; }
+
+ private:
+  // Passes in flight: each holds a splat buffer of 24 bytes a pixel.
+  static constexpr size_t kSlots = 2;
+  enum class State { Free, Granted, Launched, Read };
+  struct Slot {
+    uint32_t global = 0;
+    State state = State::Free;
+    cl::Buffer splats, tallies;
+    std::vector<uint32_t> splatWords;  // read back here
+    std::array<uint32_t, 3> tallyWords{};
+  };
+
+  DeviceContext& dc_;
+  // The paths seen through a delta lobe first, where the scene has such lobes; else null.
+  std::unique_ptr<WavefrontPipeline> cameraPaths_;
+  DeviceScene scene_;
+  gpu::RenderParams params_{};
+  unsigned pixels_;
+  cl::Kernel kernel_;
+  cl::Buffer density_;
+  std::array<Slot, kSlots> slots_;
+  uint64_t nextLaunch_ = 0, granted_ = 0;  // local passes
+  RenderStats stats_;
+  double kernelSeconds_ = 0;
+  std::vector<cl::Event> events_;
+};
+
+}  // namespace fh

@@ -1,0 +1,266 @@
+// Light tracing (--method lt): paths start on the emitters and each vertex is connected to
+// the camera (the t = 1 strategy of bidirectional path tracing, Veach 1997 §10.2), so light
+// that reaches a diffuse surface through glass or a mirror (L S+ D E paths, caustics) is
+// found from the light's side, where camera paths never find it.
+//
+// One work-item traces one light path: an emissive triangle picked by the light table and
+// a point uniform on it (density p_A), a direction cosine-distributed about its front
+// normal, then BSDF sampling with the adjoint weights (importance is carried, not radiance:
+// no 1/eta^2 through a refraction, and the shading-normal correction of Veach §5.3). Every
+// vertex with a smooth lobe, and the emitter point itself, is connected to the pinhole:
+// the contribution alpha f |cos| W / d^2 lands on the pixels whose filter covers the point
+// it is seen at.
+//
+// A pass traces one light path per pixel of the image (N = W H), so that pixel j's value
+// after the pass is sum_i alpha_i f_i |cos_i| g_j(p_i) / (A d_i^2 cos^3 theta_i): W_j, the
+// pinhole's importance for pixel j per unit solid angle, is g_j(p) W H / (A cos^3 theta)
+// (A: the film's area on the plane one unit in front of the pinhole, g_j: pixel j's filter
+// density over image positions), and the W H cancels against 1/N.
+//
+// Splats are added as whole quanta of the film (2^-24) into 64-bit integers, so a pixel's
+// sum does not depend on the order in which work-items or devices add to it: the same bits
+// on any device count, chunking and rank count.
+#include "bsdf.h"
+#include "intersect.h"
+#include "lights.h"
+#include "ray.h"
+#include "rng.h"
+#include "sampling.h"
+#include "scene_view.h"
+#include "surface.h"
+
+// A splat's resolution, the film's quantum (host/render/film.h), and its cap: 2^24 quanta
+// of radiance in one splat keep 65536 of them per pixel below 2^64.
+#define FH_SPLAT_QUANTA 16777216.0f
+#define FH_SPLAT_MOST 16777216.0f
+
+// Per pass: the pass's splats, three 64-bit sums (low, high words) per pixel.
+#define FH_SPLAT_WORDS 6
+
+// Adds v >= 0, as whole quanta, to the 64-bit integer at sum (low word first): the carry
+// out of the low word goes into the high word, so the total is exact in any order.
+FH_INLINE void add_quanta(volatile __global uint* sum, float v) {
+  const ulong q = convert_ulong_sat_rte(fmin(v, FH_SPLAT_MOST) * FH_SPLAT_QUANTA);
+  const uint low = (uint)q, high = (uint)(q >> 32);
+  if (low != 0u) {
+    const uint before = atomic_add(sum, low);
+    if (before + low < before) atomic_inc(sum + 1);
+  }
+  if (high != 0u) atomic_add(sum + 1, high);
+}
+
+// Pixel filter g(d) over one axis (a density: it integrates to one), tabulated over
+// [-radius, radius] by the host (render/pixel_filter.h).
+FH_INLINE float filter_density(__global const float* table, uint size, float radius, float d) {
+  const float x = (d + radius) / (2.0f * radius) * (float)(size - 1);
+  if (!(x >= 0.0f && x <= (float)(size - 1))) return 0.0f;
+  const uint i = min((uint)x, size - 2);
+  return mix(table[i], table[i + 1], x - (float)i);
+}
+
+// Adds the radiance c seen at image position p (pixels) to every pixel whose filter covers p,
+// weighted by its filter there. The box filter covers one pixel, the one p lies in.
+FH_INLINE void splat(RenderParams params, volatile __global uint* splats, __global const float* density, float2 p,
+                     lvec3 c) {
+  const int w = params.camera.width, h = params.camera.height;
+  const float r = params.filter_radius;
+  const int x0 = r <= 0.5f ? (int)floor(p.x) : (int)ceil(p.x - 0.5f - r);
+  const int x1 = r <= 0.5f ? x0 : (int)floor(p.x - 0.5f + r);
+  const int y0 = r <= 0.5f ? (int)floor(p.y) : (int)ceil(p.y - 0.5f - r);
+  const int y1 = r <= 0.5f ? y0 : (int)floor(p.y - 0.5f + r);
+  for (int y = max(y0, 0); y <= min(y1, h - 1); ++y) {
+    const float gy = r <= 0.5f ? 1.0f : filter_density(density, params.filter_table_size, r, p.y - ((float)y + 0.5f));
+    for (int x = max(x0, 0); x <= min(x1, w - 1); ++x) {
+      const float g =
+          gy * (r <= 0.5f ? 1.0f : filter_density(density, params.filter_table_size, r, p.x - ((float)x + 0.5f)));
+      if (g <= 0.0f) continue;
+      volatile __global uint* sum = splats + FH_SPLAT_WORDS * ((uint)y * (uint)w + (uint)x);
+      add_quanta(sum, c.x * g);
+      add_quanta(sum + 2, c.y * g);
+      add_quanta(sum + 4, c.z * g);
+    }
+  }
+}
+
+// A point as the pinhole sees it: the unit direction to the camera, from the ray origin
+// just off the surface on the camera's side; the image position (pixels, (0, 0) at the
+// top-left corner, as camera_ray_direction takes it) and the importance per pixel filter,
+// 1 / (A d^2 cos^3 theta). `seen`: in front of the camera and within a filter's reach of
+// the image.
+typedef struct {
+  lvec3 origin, to_camera;
+  float distance, importance;
+  float2 image;
+  int seen;
+} CameraView;
+
+FH_INLINE CameraView camera_view(RenderParams params, const SurfacePoint* at) {
+  const CameraParams* cam = &params.camera;
+  const lvec3 eye = v3_uniform(vload3(0, cam->origin)), f = v3_uniform(vload3(0, cam->forward)),
+              right = v3_uniform(vload3(0, cam->right)), up = v3_uniform(vload3(0, cam->up));
+  CameraView v;
+  v.origin = offset_ray_origin(at, v3_sub(eye, at->position));
+  const lvec3 d = v3_sub(eye, v.origin);
+  v.distance = v3_length(d);
+  v.to_camera = v3_scale(d, 1.0f / v.distance);
+  // Toward the point from the camera, on the image plane one unit ahead.
+  const float cos_theta = -v3_dot(v.to_camera, f);
+  const lvec3 q = v3_scale(v.to_camera, -1.0f / cos_theta);
+  const float sx = v3_dot(q, right) / v3_dot(right, right), sy = v3_dot(q, up) / v3_dot(up, up);
+  v.image = (float2)(0.5f * (sx + 1.0f) * (float)cam->width, 0.5f * (1.0f - sy) * (float)cam->height);
+  const float reach = fmax(params.filter_radius - 0.5f, 0.0f);
+  v.seen = cos_theta > 0.0f && v.distance > 0.0f && v.image.x >= -reach && v.image.x < (float)cam->width + reach &&
+           v.image.y >= -reach && v.image.y < (float)cam->height + reach;
+  const float film_area = 4.0f * v3_length(right) * v3_length(up);
+  v.importance = 1.0f / (film_area * v.distance * v.distance * cos_theta * cos_theta * cos_theta);
+  return v;
+}
+
+// What one light path counts: rays traced and contributions dropped as NaN or infinite.
+typedef struct {
+  uint bounce_rays, camera_rays, nonfinite;
+} LightTally;
+
+// Splats `value` (the contribution before the camera's importance) where the camera sees
+// v from, if nothing lies between.
+FH_INLINE void connect_to_camera(RenderParams params, const SceneView* scene, const CameraView* v, lvec3 value,
+                                 volatile __global uint* splats, __global const float* density, LightTally* tally) {
+  const lvec3 c = v3_scale(value, v->importance);
+  if (!v3_any_positive(c)) return;
+  if (!(isfinite(c.x) && isfinite(c.y) && isfinite(c.z))) {
+    ++tally->nonfinite;
+    return;
+  }
+  ++tally->camera_rays;
+  const float3 org = (float3)(v->origin.x, v->origin.y, v->origin.z);
+  const float3 dir = (float3)(v->to_camera.x, v->to_camera.y, v->to_camera.z);
+  if (find_occluder(scene->nodes, scene->blocks, org, dir, 0.0f, v->distance * FH_SHADOW_SHORTEN) < 0)
+    splat(params, splats, density, v->image, c);
+}
+
+// The surface a light path reached: point, normals (the shading normal on the geometric
+// normal's side, as shade's shading_at gives it) and BSDF, textured.
+typedef struct {
+  SurfacePoint point;
+  lvec3 shading_normal;
+  Bsdf bsdf;
+} LightVertex;
+
+FH_INLINE LightVertex light_vertex(const SceneView* scene, TraceHit hit) {
+  LightVertex v;
+  v.point = surface_point(scene->triangles, hit.triangle, hit.b1, hit.b2);
+  const MaterialLanes m = material_lanes(scene->materials, scene->triangle_material[hit.triangle]);
+  v.bsdf = material_bsdf(&m);
+#if defined(FH_SHADING_NORMALS)
+  v.shading_normal = shading_normal(scene->normals, hit.triangle, hit.b1, hit.b2, v.point.normal);
+#else
+  v.shading_normal = v.point.normal;
+#endif
+#if defined(FH_TEXTURES)
+  v.bsdf.kd = texture_lookup(scene->texels, scene->texture_info, m.texture,
+                             surface_uv(scene->uvs, hit.triangle, hit.b1, hit.b2), v.bsdf.kd);
+#endif
+  return v;
+}
+
+// The adjoint weight of a BSDF sample taken with wo = w_in (toward where the light came
+// from): f(w_next <- w_in) |n.w_in| |g.w_next| / (|g.w_in| pdf), the shading normal's cosine
+// at the incoming side in place of the geometric one (Veach §5.3). Smooth lobes are
+// evaluated the other way round (the diffuse share depends on the outgoing direction); a
+// delta lobe's radiance weight is used without the 1/eta^2 of a refraction, which
+// radiance has and importance has not.
+FH_INLINE lvec3 adjoint_weight(const LightVertex* v, lvec3 n, lvec3 w_in, const BsdfSample* s) {
+  const float cos_g_in = fabs(v3_dot(v->point.normal, w_in)), cos_g_next = fabs(v3_dot(v->point.normal, s->wi));
+  const float correction = fabs(v3_dot(n, w_in)) * cos_g_next / cos_g_in;
+  if (s->pdf > 0.0f) return v3_scale(bsdf_eval(&v->bsdf, n, s->wi, w_in), correction / s->pdf);
+  lvec3 weight = v3_scale(s->weight, correction / fabs(v3_dot(n, s->wi)));
+#if defined(FH_GLASS)
+  const int refracted = v3_dot(v->point.normal, w_in) * v3_dot(v->point.normal, s->wi) < 0.0f;
+  if (has_lobe(&v->bsdf, FH_LOBE_GLASS) && refracted) {
+    const float eta = v3_dot(v->point.normal, w_in) >= 0.0f ? v->bsdf.eta : 1.0f / v->bsdf.eta;
+    weight = v3_scale(weight, eta * eta);
+  }
+#endif
+  return weight;
+}
+
+__kernel void light_trace(RenderParams params, uint pass, __global uint* splats, __global const float* density,
+                          __global uint* tallies FH_SCENE_PARAMS) {
+  const uint path = get_global_id(0);
+  if (path >= params.pixel_count || params.light_count == 0u) return;
+  const SceneView scene = FH_SCENE_VIEW;
+  const uint stream = hash_combine(params.seed, pass);
+  uint dim = 0u;
+  LightTally tally = {0u, 0u, 0u};
+
+  // The emitter point: a triangle by the light table, then uniform in its area.
+  const float u_pick = random_float(stream, path, dim++);
+  const int light = scene.light_triangle[pick_light(scene.light_cdf, params.light_count, u_pick)];
+  const float u1 = random_float(stream, path, dim++), u2 = random_float(stream, path, dim++);
+  const lvec2 b = sample_triangle(u1, u2);
+  const SurfacePoint y = surface_point(scene.triangles, light, b.x, b.y);
+  const lvec3 le = material_lanes(scene.materials, scene.triangle_material[light]).ke;
+  // alpha: the path's weight per unit area at its last vertex, Le / p_A at the emitter.
+  lvec3 alpha = v3_scale(le, 1.0f / scene.light_pdf_area[light]);
+
+  // The emitter seen directly: Ke leaves the front side only.
+  CameraView view = camera_view(params, &y);
+  const float cos_light = v3_dot(y.normal, view.to_camera);
+  if (view.seen && cos_light > 0.0f)
+    connect_to_camera(params, &scene, &view, v3_scale(alpha, cos_light), splats, density, &tally);
+
+  // Leave the light cosine-distributed about its front normal: Le cos / (p_A cos / pi).
+  const float u3 = random_float(stream, path, dim++), u4 = random_float(stream, path, dim++);
+  lvec3 dir = sample_cosine_hemisphere(y.normal, u3, u4);
+  lvec3 org = offset_ray_origin(&y, dir);
+  alpha = v3_scale(alpha, M_PI_F);
+  lvec3 carried = v3_splat(1.0f);  // the BSDF weights since the light: what roulette reads
+
+  for (uint scatterings = 1u; scatterings <= params.max_depth; ++scatterings) {
+    ++tally.bounce_rays;
+    const TraceHit hit = trace_ray(scene.nodes, scene.blocks, (float3)(org.x, org.y, org.z),
+                                   (float3)(dir.x, dir.y, dir.z), 0.0f, INFINITY);
+    if (hit.triangle < 0) break;
+    const LightVertex v = light_vertex(&scene, hit);
+    const lvec3 w_in = v3_neg(dir);
+    const float cos_g_in = v3_dot(v.point.normal, w_in);
+    if (cos_g_in == 0.0f) break;
+    // The normals on the side the light arrives from.
+    const lvec3 g = cos_g_in > 0.0f ? v.point.normal : v3_neg(v.point.normal);
+    const lvec3 n = cos_g_in > 0.0f ? v.shading_normal : v3_neg(v.shading_normal);
+
+    // The camera through the smooth lobes: f(w_camera <- w_in), the shading cosine at the
+    // incoming side (Veach §5.3), the geometric one toward the camera.
+    if (bsdf_has_smooth_lobe(&v.bsdf)) {
+      view = camera_view(params, &v.point);
+      const float cos_camera = v3_dot(g, view.to_camera);
+      if (view.seen && cos_camera > 0.0f) {
+        const lvec3 f = bsdf_eval(&v.bsdf, n, view.to_camera, w_in);
+        connect_to_camera(params, &scene, &view,
+                          v3_scale(v3_mul(alpha, f), fabs(v3_dot(n, w_in)) * cos_camera / fabs(cos_g_in)), splats,
+                          density, &tally);
+      }
+    }
+    if (scatterings == params.max_depth) break;
+
+    const float u0 = random_float(stream, path, dim++);
+    const float u5 = random_float(stream, path, dim++), u6 = random_float(stream, path, dim++);
+    const BsdfSample s = bsdf_sample(&v.bsdf, v.point.normal, v.shading_normal, w_in, u0, u5, u6);
+    if (s.pdf == 0.0f) break;
+    const lvec3 weight = adjoint_weight(&v, n, w_in, &s);
+    alpha = v3_mul(alpha, weight);
+    carried = v3_mul(carried, weight);
+    if (scatterings >= params.rr_depth) {
+      const float survive = fmin(v3_max_component(carried), 0.95f);
+      if (random_float(stream, path, dim++) >= survive) break;
+      alpha = v3_scale(alpha, 1.0f / survive);
+      carried = v3_scale(carried, 1.0f / survive);
+    }
+    if (!v3_any_positive(alpha)) break;
+    dir = s.wi;
+    org = offset_ray_origin(&v.point, s.wi);
+  }
+  atomic_add(tallies, tally.bounce_rays);
+  atomic_add(tallies + 1, tally.camera_rays);
+  if (tally.nonfinite) atomic_add(tallies + 2, tally.nonfinite);
+}
