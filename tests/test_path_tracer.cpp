@@ -887,6 +887,23 @@ TEST(LightTracing, PlaneUnderRectangularEmitterFollowsLambertsFormula) {
   expectLambertsPlane(planeWithNormalsAgainstTheWinding(), Method::LT, "lt, normals against the winding");
 }
 
+// The same plane under a light 4096 times as bright: the pixels that see the light gather
+// more than 2^32 film quanta in a pass, so each splat's carry out of the low word counts.
+TEST(LightTracing, SplatsPastTwoToTheThirtyTwoQuantaCarry) {
+  const double scale = 4096;
+  Scene scene = PlaneUnderLight::scene();
+  for (Material& m : scene.materials) m.ke = m.ke * float(scale);
+  scene.lights.clear();
+  collectLights(scene);
+  RenderSettings s = test::renderSettings();
+  s.method = Method::LT;
+  s.width = s.height = 24;
+  s.spp = 64;
+  const RenderResult r = test::render(scene, scene.camera, s);
+  const Image exact = PlaneUnderLight::reference(scene.camera, 24, 24, 8, true);
+  expectMatches(r.film, [&](size_t p) { return scale * double(exact.rgb[3 * p]); }, "lt, a bright light");
+}
+
 RenderResult renderWithMethod(const Scene& scene, Method method, int size, int spp, unsigned seed,
                               PixelFilter filter = PixelFilter::Box) {
   RenderSettings s = test::renderSettings();
