@@ -64,15 +64,13 @@ FH_INLINE void splat(RenderParams params, volatile __global uint* splats, __glob
                      lvec3 c) {
   const int w = params.camera.width, h = params.camera.height;
   const float r = params.filter_radius;
-  const int x0 = r <= 0.5f ? (int)floor(p.x) : (int)ceil(p.x - 0.5f - r);
-  const int x1 = r <= 0.5f ? x0 : (int)floor(p.x - 0.5f + r);
-  const int y0 = r <= 0.5f ? (int)floor(p.y) : (int)ceil(p.y - 0.5f - r);
-  const int y1 = r <= 0.5f ? y0 : (int)floor(p.y - 0.5f + r);
+  const bool box = r <= 0.5f;  // weight one in the pixel p lies in, none elsewhere
+  const int x0 = box ? (int)floor(p.x) : (int)ceil(p.x - 0.5f - r), x1 = box ? x0 : (int)floor(p.x - 0.5f + r);
+  const int y0 = box ? (int)floor(p.y) : (int)ceil(p.y - 0.5f - r), y1 = box ? y0 : (int)floor(p.y - 0.5f + r);
   for (int y = max(y0, 0); y <= min(y1, h - 1); ++y) {
-    const float gy = r <= 0.5f ? 1.0f : filter_density(density, params.filter_table_size, r, p.y - ((float)y + 0.5f));
+    const float gy = box ? 1.0f : filter_density(density, params.filter_table_size, r, p.y - ((float)y + 0.5f));
     for (int x = max(x0, 0); x <= min(x1, w - 1); ++x) {
-      const float g =
-          gy * (r <= 0.5f ? 1.0f : filter_density(density, params.filter_table_size, r, p.x - ((float)x + 0.5f)));
+      const float g = gy * (box ? 1.0f : filter_density(density, params.filter_table_size, r, p.x - ((float)x + 0.5f)));
       if (g <= 0.0f) continue;
       volatile __global uint* sum = splats + FH_SPLAT_WORDS * ((uint)y * (uint)w + (uint)x);
       add_quanta(sum, c.x * g);

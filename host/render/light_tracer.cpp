@@ -22,10 +22,14 @@ ProgramSpec lightTracerProgram(const SceneFeatures& features, const std::string&
 
 LightTracer::LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bvh& bvh, const Camera& camera,
                          const RenderSettings& s)
-    : dc_(dc), scene_(dc, scene, bvh), pixels_(unsigned(s.width) * unsigned(s.height)) {
-  // Delta lobes: glass, and mirrors (compiled with the glossy lobes).
-  if (scene_.features.glass || scene_.features.glossy)
-    cameraPaths_ = std::make_unique<WavefrontPipeline>(dc, scene, bvh, camera, s);
+    : dc_(dc),
+      // Delta lobes: glass, and mirrors (compiled with the glossy lobes).
+      cameraPaths_(scene.features.glass || scene.features.glossy
+                       ? std::make_unique<WavefrontPipeline>(dc, scene, bvh, camera, s)
+                       : nullptr),
+      ownScene_(cameraPaths_ ? nullptr : std::make_unique<DeviceScene>(dc, scene, bvh)),
+      scene_(cameraPaths_ ? cameraPaths_->deviceScene() : *ownScene_),
+      pixels_(unsigned(s.width) * unsigned(s.height)) {
   std::vector<float> inverseCdf;
   params_ = renderParams(s, camera, scene_, inverseCdf);
   // The splats weigh by the filter's density where camera rays are offset by its inverse CDF.

@@ -59,7 +59,9 @@ class LightTracer : public PassRenderer {
   DeviceContext& dc_;
   // The paths seen through a delta lobe first, where the scene has such lobes; else null.
   std::unique_ptr<WavefrontPipeline> cameraPaths_;
-  DeviceScene scene_;
+  // The scene on the device, uploaded once: the camera paths' where there are any.
+  std::unique_ptr<DeviceScene> ownScene_;
+  const DeviceScene& scene_;
   gpu::RenderParams params_{};
   unsigned pixels_;
   cl::Kernel kernel_;

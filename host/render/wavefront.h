@@ -110,6 +110,8 @@ class WavefrontPipeline : public PassRenderer {
   // This device's counts so far (samples are the film's to count) and stage times.
   RenderStats stats() override;
   size_t wavefront() const override { return wavefront_; }
+  // The scene's buffers on this device (the light tracer's camera paths share them).
+  const DeviceScene& deviceScene() const { return scene_; }
   Strategy strategy() const override { return strategy_; }
 
  private:
