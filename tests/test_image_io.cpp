@@ -243,6 +243,25 @@ TEST(InputGate, AnExrHeaderClaimingMoreThanItsFileHoldsIsRefusedBeforeOpenExrOpe
     EXPECT_EQ(std::string(e.what()), "texture '" + path + "': its header claims 100000x100000x3 pixels, more than the " +
                                          std::to_string(kMaxImagePixels) + " fredholm reads");
   }
+  // OpenEXR reads a channel list up to its empty name, whatever its size says: one 3 bytes
+  // shorter than its channels (found by fuzzing) had OpenEXR read a later string's 1.6 GB claim
+  // from where this check saw the end of the header.
+  test::writeFile(path, magic + exrAttribute("channels", "chlist", channels.substr(channels.size() - 55), 52) +
+                            exrAttribute("spp", "string", "1", 1610612740u) + std::string(64, 'x'));
+  try {
+    readImage(path, "compare");
+    FAIL() << "read";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "compare '" + path +
+                                         "': its EXR attribute 'channels' of type 'chlist' does not fill the 52 "
+                                         "bytes it claims");
+  }
+  // A vector of strings allocates each string's claim inside the value; a box its 16 bytes.
+  for (const std::string& lie : {exrAttribute("names", "stringvector", littleEndian({1610612740}) + "ab", 6),
+                                 exrAttribute("dataWindow", "box2i", littleEndian({0, 0, 3}), 12)}) {
+    test::writeFile(path, magic + lie + std::string(64, 'x'));
+    EXPECT_THROW(readImage(path, "compare"), Error);
+  }
   // An EXR fredholm wrote passes.
   writeImage(path, gradient(5, 3), {{"spp", "4"}});
   EXPECT_EQ(readImage(path, "compare").width, 5);

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include "base/atomic_file.h"
 #include "base/error.h"
@@ -229,12 +230,56 @@ uint32_t littleEndian32(const unsigned char* b) {
   return uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
 }
 
+// The channels of an EXR channel list: each a name, NUL and 16 bytes, up to an empty name.
+// -1 where the list does not end exactly at the end of its value.
+long long exrChannelCount(const std::string& value) {
+  long long count = 0;
+  for (size_t at = 0; at < value.size(); ++count) {
+    const size_t end = value.find('\0', at);
+    if (end == std::string::npos || end - at > 255) return -1;
+    if (end == at) return end + 1 == value.size() ? count : -1;
+    at = end + 17;
+  }
+  return -1;
+}
+
+// Whether an attribute's value is laid out as OpenEXR reads its type: the types OpenEXR reads
+// by layout must be exactly as long as their size says, and the vectors of strings and the
+// preview, which allocate what they read inside the value, must fit in it. Types OpenEXR reads
+// by their size alone (string, floatvector, opaque ones) fit by the size check already.
+bool exrLayoutFits(const std::string& type, const std::string& value) {
+  static const std::map<std::string, size_t> fixedSizes = {
+      {"box2i", 16},  {"box2f", 16},      {"v2i", 8},          {"v2f", 8},        {"v2d", 16},    {"v3i", 12},
+      {"v3f", 12},    {"v3d", 24},        {"m33f", 36},        {"m33d", 72},      {"m44f", 64},   {"m44d", 128},
+      {"int", 4},     {"float", 4},       {"double", 8},       {"rational", 8},   {"timecode", 8}, {"keycode", 28},
+      {"envmap", 1},  {"lineOrder", 1},   {"compression", 1},  {"deepImageState", 1}, {"tiledesc", 9},
+      {"chromaticities", 32}};
+  const auto fixed = fixedSizes.find(type);
+  if (fixed != fixedSizes.end()) return value.size() == fixed->second;
+  const auto* v = reinterpret_cast<const unsigned char*>(value.data());
+  if (type == "chlist") return exrChannelCount(value) >= 0;
+  if (type == "preview")
+    return value.size() >= 8 &&
+           uint64_t(littleEndian32(v)) * littleEndian32(v + 4) * 4 + 8 == uint64_t(value.size());
+  if (type == "stringvector") {
+    for (size_t at = 0; at < value.size();) {
+      if (value.size() - at < 4 || littleEndian32(v + at) > value.size() - at - 4) return false;
+      at += 4 + littleEndian32(v + at);
+    }
+  }
+  return true;
+}
+
 // An OpenEXR file's headers must fit in it too: OpenEXR allocates what an attribute's size
 // claims before reading it (a string attribute claiming 1.6 GB in a 900-byte file, found by
 // fuzzing), and an offset table as long as a part's data window is tall, all while opening
 // the file, before its spec can be checked. So each attribute must fit in the file, and each
-// part's data window and channels are a claim like any header's (checkImageClaim). A header
-// cut short is left to OpenEXR to report.
+// part's data window and channels are a claim like any header's (checkImageClaim). OpenEXR
+// reads most types by their layout, not by the size the attribute gives, so an attribute whose
+// layout disagrees with its size is refused too: OpenEXR would read the rest of the header from
+// another place than this check does (a channel list 3 bytes short, found by fuzzing, had it
+// read a string claiming 1.6 GB that this check never saw). A header cut short is left to
+// OpenEXR to report.
 void checkExrHeaders(const std::string& path, const std::string& what, uint64_t fileBytes) {
   std::ifstream in(path, std::ios::binary);
   unsigned char head[8];
@@ -267,26 +312,18 @@ void checkExrHeaders(const std::string& path, const std::string& what, uint64_t 
         throw Error(what + " '" + path + "': its EXR attribute '" + name + "' claims " + std::to_string(bytes) +
                     " bytes, more than the file holds");
       at += bytes;
-      const bool isWindow = name == "dataWindow" && type == "box2i" && bytes == 16;
-      const bool isChannels = name == "channels" && type == "chlist";
-      if (!isWindow && !isChannels) {
-        in.seekg(std::streamoff(bytes), std::ios::cur);
-        continue;
-      }
       std::string value(bytes, '\0');
-      if (!in.read(&value[0], std::streamsize(bytes))) return;
+      if (bytes > 0 && !in.read(&value[0], std::streamsize(bytes))) return;
+      if (!exrLayoutFits(type, value))
+        throw Error(what + " '" + path + "': its EXR attribute '" + name + "' of type '" + type + "' does not fill the " +
+                    std::to_string(bytes) + " bytes it claims");
       const auto* v = reinterpret_cast<const unsigned char*>(value.data());
-      if (isWindow) {
+      if (name == "dataWindow" && type == "box2i") {
         window = true;
         width = (long long)int32_t(littleEndian32(v + 8)) - (long long)int32_t(littleEndian32(v)) + 1;
         height = (long long)int32_t(littleEndian32(v + 12)) - (long long)int32_t(littleEndian32(v + 4)) + 1;
-      } else {
-        // Each channel: its name, NUL, then 16 bytes; an empty name ends the list.
-        for (size_t i = 0; i < value.size() && value[i] != '\0'; ++channels) {
-          const size_t end = value.find('\0', i);
-          if (end == std::string::npos) break;
-          i = end + 17;
-        }
+      } else if (name == "channels" && type == "chlist") {
+        channels = exrChannelCount(value);
       }
     }
     if (!any) return;  // the empty header that ends a multi-part file's list
