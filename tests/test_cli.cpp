@@ -20,7 +20,7 @@ namespace {
 TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
   const std::string dir = test::tempDir("cli");
   const std::pair<const char*, const char*> cases[] = {
-      {"--method foo", "--method 'foo': unknown method (use pt, nee, mis or lt)"},
+      {"--method foo", "--method 'foo': unknown method (use pt, nee, mis, lt or auto)"},
       {"--filter tent", "--filter 'tent': unknown filter"},
       {"--env 1,1,x", "--env '1,1,x': 'x' is not a number"},
       {"--aov shiny", "--aov 'shiny': unknown output"},

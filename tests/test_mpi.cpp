@@ -133,7 +133,7 @@ TEST(Mpi, CtrlCWritesThePassesFinishedSoFar) {
 
 TEST(Mpi, WhatRanksCannotShareIsAOneLineErrorThatEndsTheJob) {
   const std::string dir = test::tempDir("mpi-refused");
-  for (const std::string flag : {"--noise 1e-2", "--adaptive"}) {
+  for (const std::string flag : {"--noise 1e-2", "--adaptive", "--method auto"}) {
     const auto r = mpirun(2, kRender + flag + " -o " + dir + "/n.exr");
     EXPECT_NE(r.exitCode, 0);
     const std::string error =

@@ -16,7 +16,7 @@ Method parseMethod(const std::string& name) {
   if (name == "nee") return Method::NEE;
   if (name == "mis") return Method::MIS;
   if (name == "lt") return Method::LT;
-  throw Error("--method '" + name + "': unknown method (use pt, nee, mis or lt)");
+  throw Error("--method '" + name + "': unknown method (use pt, nee, mis, lt or auto)");
 }
 
 Strategy parseStrategy(const std::string& name) {

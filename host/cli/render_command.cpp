@@ -12,6 +12,8 @@
 #include <optional>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "base/atomic_file.h"
 #include "base/output_plan.h"
 #include "base/vec.h"
@@ -23,6 +25,7 @@
 #include "image/denoiser.h"
 #include "image/image_io.h"
 #include "render/checkpoint.h"
+#include "render/method_choice.h"
 #include "render/render.h"
 #include "render/render_aov.h"
 #include "render/wavefront.h"
@@ -121,6 +124,18 @@ void lightTracingFits(const RenderOptions& o, const RenderSettings& s) {
                 "; use mis");
 }
 
+// --method auto pilots each method in this process, on this process's devices: what must
+// share one method with another process, or has none, is an error before any work.
+void autoFits(const RenderOptions& o) {
+  const std::pair<bool, const char*> clashes[] = {
+      {!o.passes.empty(), "--passes (every chunk must have the method of the others)"},
+      {!o.resume.empty(), "--resume (the checkpoint's render chose its method already; auto printed it)"},
+      {!o.aov.empty(), "--aov (a debug view has no method)"}};
+  for (const auto& [given, flag] : clashes)
+    if (given) throw Error(std::string("--method auto chooses a method per render and does not go with ") + flag +
+                           "; give the method (pt, nee, mis or lt)");
+}
+
 // --seed: the sampler's seed is 32 bits.
 unsigned parseSeed(const std::string& text) {
   const bool digits = !text.empty() && text.size() <= 10 && text.find_first_not_of("0123456789") == std::string::npos;
@@ -133,7 +148,9 @@ unsigned parseSeed(const std::string& text) {
 // with --time or --noise and no --spp as many as they take (up to 2^20, whatever the image).
 RenderSettings settingsFrom(const RenderOptions& o) {
   RenderSettings s;
-  s.method = parseMethod(o.method);
+  // auto: mis until the pilot chooses (choosePilotedMethod).
+  s.method = o.method == "auto" ? Method::MIS : parseMethod(o.method);
+  if (o.method == "auto") autoFits(o);
   s.strategy = parseStrategy(o.strategy);
   s.filter = parseFilter(o.filter);
   if (!o.env.empty()) s.env = parseVec3Flag("--env", o.env);
@@ -286,8 +303,10 @@ int mpiRank(const RenderOptions& o) {
 // Under mpirun: what a render shared by ranks cannot do (yet), refused on every rank alike;
 // and one progress display, rank 0's (every rank's stderr reaches the terminal).
 void checkSharedRender(const RenderOptions& o, RenderSettings& settings, int rank) {
-  const std::pair<bool, const char*> clashes[] = {
-      {o.noise > 0, "--noise"}, {o.adaptive, "--adaptive"}, {!o.aov.empty(), "--aov"}};
+  const std::pair<bool, const char*> clashes[] = {{o.noise > 0, "--noise"},
+                                                  {o.adaptive, "--adaptive"},
+                                                  {!o.aov.empty(), "--aov"},
+                                                  {o.method == "auto", "--method auto (each rank would pilot alone)"}};
   for (const auto& [given, flag] : clashes)
     if (given) throw Error(std::string("under mpirun, ranks share a render without ") + flag + " (not yet supported)");
   settings.progress = rank == 0;
@@ -317,6 +336,34 @@ RenderResult renderOnEveryRank(const RenderOptions& o, const std::vector<DeviceI
 #endif
   (void)o;
   return render(devices, scene, bvh, camera, settings, links);
+}
+
+// --method auto: the pilots, then the settings for the method chosen. A time budget is the
+// whole render's: what the pilots took comes off it (at least a pass is rendered).
+MethodChoice choosePilotedMethod(const std::vector<DeviceInfo>& devices, const Scene& scene, const Bvh& bvh,
+                                 const Camera& camera, RenderSettings& settings, const RenderLinks& links) {
+  std::string names;
+  for (Method m : methodsFor(scene, settings)) names += (names.empty() ? "" : ", ") + std::string(methodName(m));
+  std::cerr << "fredholm: --method auto: a pilot render with each of " << names << "\n";
+  const MethodChoice choice = chooseMethod(devices, scene, bvh, camera, settings, links.stop);
+  if (links.stopRequested()) throw Interrupted("during --method auto's pilot renders; nothing written", links.stop->load());
+  settings.method = choice.method;
+  settings.fingerprint = renderFingerprint(scene, camera, settings);
+  if (settings.seconds > 0) settings.seconds = std::max(settings.seconds - choice.seconds, 1e-6);
+  std::cerr << "fredholm: --method auto chose " << methodName(choice.method) << " (relMSE x seconds of a "
+            << choice.pilotWidth << "x" << choice.pilotHeight << ", " << choice.pilotSpp
+            << "-spp pilot: " << choice.describeCosts() << "; pilots took " << formatSeconds(choice.seconds) << " s)\n";
+  return choice;
+}
+
+// The choice and its figures, for --stats.
+nlohmann::json choiceJson(const MethodChoice& c) {
+  nlohmann::json methods = nlohmann::json::object();
+  for (const MethodTrial& t : c.trials)
+    methods[methodName(t.method)] = {{"seconds", t.seconds}, {"relmse", t.relMse}, {"cost", t.cost()}};
+  return {{"chosen", methodName(c.method)}, {"margin", kChoiceMargin},   {"pilot_width", c.pilotWidth},
+          {"pilot_height", c.pilotHeight},  {"pilot_spp", c.pilotSpp}, {"seconds", c.seconds},
+          {"methods", methods}};
 }
 
 // The image's radiance denoised, written with the render's metadata and what denoised it.
@@ -423,13 +470,19 @@ int runRender(RenderOptions o) {
   }
   const auto start = std::chrono::steady_clock::now();
   const Bvh bvh = buildBvh(scene);
+  const std::optional<MethodChoice> choice =
+      o.method == "auto" && !debugView
+          ? std::optional<MethodChoice>(choosePilotedMethod(devices, scene, bvh, camera, settings, links))
+          : std::nullopt;
   const RenderResult r = debugView ? renderDebugView(aov, devices, scene, bvh, camera, settings, links)
                                    : renderOnEveryRank(o, devices, scene, bvh, camera, settings, links);
   if (rank != 0) return 0;  // rank 0 holds the film, and writes
   const std::string method = debugView ? "aov:" + o.aov : methodName(settings.method);
   reportDevices(r);
   if (!o.statsFile.empty() && !debugView) {
-    writeTextAtomically(o.statsFile, "--stats", statsJson(r.stats, settings) + "\n");
+    nlohmann::json stats = nlohmann::json::parse(statsJson(r.stats, settings));
+    if (choice) stats["method_choice"] = choiceJson(*choice);
+    writeTextAtomically(o.statsFile, "--stats", stats.dump(2) + "\n");
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // The film's samples per pixel (a noise target drops the passes finished past it), over
@@ -439,6 +492,9 @@ int runRender(RenderOptions o) {
   const double estimatedRelMse = debugView ? 0.0 : r.film.estimatedRelMse();
   std::map<std::string, std::string> metadata = imageMetadata(o, scene, r, method, spp, seconds, estimatedRelMse);
   if (settings.adaptive) metadata["adaptive"] = "1";
+  if (choice)
+    metadata["method_choice"] = "auto: relMSE x seconds of a " + std::to_string(choice->pilotWidth) + "x" +
+                                std::to_string(choice->pilotHeight) + " pilot: " + choice->describeCosts();
   const Image image = r.film.imageWithLayers(layers);
   const std::string passes = std::to_string(r.film.passes()) + " passes";
   // The files, and the live view's last frame: the image as written.

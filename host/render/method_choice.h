@@ -1,0 +1,57 @@
+// --method auto: a short pilot render with each method that can render the scene, each
+// one's error per unit of time measured (relMSE estimated from its two replicates, times its
+// seconds: at equal time, the image's relMSE is that cost over the time), then the render with
+// the cheapest. mis is the default: another method must beat it clearly, by more than a pilot's
+// estimate can be off, because mis is never far from the better of pt and nee, and a method
+// chosen on a pilot's luck could be far from it.
+#pragma once
+#include <atomic>
+#include <string>
+#include <vector>
+
+#include "accel/bvh.h"
+#include "device/devices.h"
+#include "render/settings.h"
+#include "scene/camera.h"
+#include "scene/scene.h"
+
+namespace fh {
+
+// Another method is chosen over mis only where its pilot cost is below this share of mis's.
+constexpr double kChoiceMargin = 0.8;
+// The pilot: the image scaled down to at most this many pixels a side, at this many passes
+// (enough for the noise estimate, whose two halves need kNoiseMinPasses between them).
+constexpr int kPilotSide = 128;
+constexpr int kPilotSpp = 64;
+
+struct MethodTrial {
+  Method method = Method::MIS;
+  double seconds = 0.0;  // the pilot's render time (set-up and compiling excluded)
+  double relMse = 0.0;   // the pilot image's estimated relMSE
+  double cost() const { return relMse * seconds; }
+};
+
+struct MethodChoice {
+  Method method = Method::MIS;
+  int pilotWidth = 0, pilotHeight = 0, pilotSpp = kPilotSpp;
+  double seconds = 0.0;  // the whole pilot, set-up included
+  std::vector<MethodTrial> trials;
+  // "pt 3.3e-02, nee 7.7e-03, mis 8.4e-03, lt 5.5e-03": each trial's cost.
+  std::string describeCosts() const;
+};
+
+// The methods that can render the scene with these settings: pt, nee and mis always; lt
+// where the scene has emitting triangles and nothing it cannot do is asked (an environment,
+// adaptive passes, first-surface layers).
+std::vector<Method> methodsFor(const Scene& scene, const RenderSettings& s);
+
+// Of the trials, the method the render should use: the cheapest where it beats mis's cost by
+// kChoiceMargin, else mis.
+Method cheapestMethod(const std::vector<MethodTrial>& trials);
+
+// Runs the pilots on the render's devices and chooses. `stop` (as RenderLinks::stop) ends
+// the pilot early; the choice is then mis.
+MethodChoice chooseMethod(const std::vector<DeviceInfo>& devices, const Scene& scene, const Bvh& bvh,
+                          const Camera& camera, const RenderSettings& s, const std::atomic<int>* stop);
+
+}  // namespace fh

@@ -1,0 +1,141 @@
+// --method auto: the rule that picks from the pilots' costs, the methods a scene is piloted
+// with, and the command line: the scenes the failure suite names get the method that is
+// known to win there (mis on the Cornell box, whose light every method finds; light tracing
+// on the caustic scene, whose caustic camera paths find by chance), the image is the chosen
+// method's for the seed, and what auto cannot do is a one-line error before any work.
+#include <gtest/gtest.h>
+#include <OpenImageIO/imageio.h>
+
+#include <string>
+
+#include "cli/flags.h"
+#include "image/image_io.h"
+#include "render/method_choice.h"
+#include "scene/scene_loader.h"
+#include "test_support.h"
+
+namespace fh {
+namespace {
+
+std::vector<MethodTrial> trials(double pt, double nee, double mis, double lt) {
+  // Costs as relMSE x seconds, one second each.
+  return {{Method::PT, 1.0, pt}, {Method::NEE, 1.0, nee}, {Method::MIS, 1.0, mis}, {Method::LT, 1.0, lt}};
+}
+
+TEST(MethodChoice, AnotherMethodMustBeatMisByTheMargin) {
+  EXPECT_EQ(cheapestMethod(trials(9.0, 0.85, 1.0, 2.0)), Method::MIS);  // nee ahead, within a pilot's error
+  EXPECT_EQ(cheapestMethod(trials(9.0, 0.79, 1.0, 2.0)), Method::NEE);
+  EXPECT_EQ(cheapestMethod(trials(9.0, 1.1, 1.0, 0.3)), Method::LT);
+  EXPECT_EQ(cheapestMethod(trials(0.2, 1.1, 1.0, 0.3)), Method::PT);   // the cheapest, not the first below
+  EXPECT_EQ(cheapestMethod(trials(0.0, 0.0, 0.0, 0.0)), Method::MIS);  // a black image: no error to compare
+  EXPECT_EQ(cheapestMethod({}), Method::MIS);                          // stopped before any pilot
+  // The time counts as much as the error: half the error at three times the time loses.
+  EXPECT_EQ(cheapestMethod({{Method::MIS, 1.0, 1.0}, {Method::LT, 3.0, 0.5}}), Method::MIS);
+}
+
+TEST(MethodChoice, LightTracingIsPilotedWhereItCanRenderTheScene) {
+  const Scene cornell = loadDefaultScene();
+  RenderSettings s;
+  EXPECT_EQ(methodsFor(cornell, s), (std::vector<Method>{Method::PT, Method::NEE, Method::MIS, Method::LT}));
+  const std::vector<Method> cameraOnly = {Method::PT, Method::NEE, Method::MIS};
+  RenderSettings env = s;
+  env.env = {0.1f, 0.1f, 0.1f};
+  EXPECT_EQ(methodsFor(cornell, env), cameraOnly);
+  RenderSettings adaptive = s;
+  adaptive.adaptive = true;
+  EXPECT_EQ(methodsFor(cornell, adaptive), cameraOnly);
+  RenderSettings layers = s;
+  layers.surfaceAovs = true;
+  EXPECT_EQ(methodsFor(cornell, layers), cameraOnly);
+  Scene dark = cornell;
+  dark.lights.clear();
+  EXPECT_EQ(methodsFor(dark, s), cameraOnly);
+}
+
+struct AutoRender {
+  test::CommandResult run;
+  nlohmann::json stats;
+  std::string image;
+};
+
+AutoRender renderAuto(const std::string& scene, const std::string& flags) {
+  const std::string dir = test::tempDir("auto");
+  AutoRender r;
+  r.image = dir + "/auto.exr";
+  r.run = test::runFredholm("render " + scene + " --method auto --width 128 --height 128 --spp 1 -o " + r.image +
+                            " --stats " + dir + "/stats.json " + flags);
+  if (r.run.exitCode == 0) r.stats = test::readJson(dir + "/stats.json");
+  return r;
+}
+
+// The choice in --stats, in the image's metadata and on stderr, made by the rule above from the
+// pilots' own figures.
+void expectChoice(const AutoRender& r, const std::string& method, size_t methods) {
+  ASSERT_EQ(r.run.exitCode, 0) << r.run.output;
+  const nlohmann::json& choice = r.stats["method_choice"];
+  EXPECT_EQ(choice["chosen"], method) << choice.dump(2);
+  EXPECT_EQ(r.stats["method"], method);
+  ASSERT_EQ(choice["methods"].size(), methods) << choice.dump(2);
+  std::vector<MethodTrial> pilots;
+  for (const auto& [name, trial] : choice["methods"].items()) {
+    EXPECT_GT(trial["relmse"].get<double>(), 0.0) << name;
+    EXPECT_GT(trial["seconds"].get<double>(), 0.0) << name;
+    pilots.push_back({parseMethod(name), trial["seconds"], trial["relmse"]});
+  }
+  EXPECT_EQ(methodName(cheapestMethod(pilots)), method);
+  EXPECT_NE(r.run.output.find("--method auto chose " + method + " ("), std::string::npos) << r.run.output;
+  auto in = OIIO::ImageInput::open(r.image);
+  ASSERT_TRUE(in);
+  EXPECT_EQ(in->spec().get_string_attribute("fredholm:method"), method);
+  EXPECT_NE(in->spec().get_string_attribute("fredholm:method_choice").find("relMSE x seconds"), std::string::npos);
+}
+
+TEST(MethodChoiceCli, TheCornellBoxGetsMis) {
+  expectChoice(renderAuto(test::projectScene("cornell-box/CornellBox-Original.obj"), ""), "mis", 4);
+}
+
+TEST(MethodChoiceCli, TheCausticSceneGetsLightTracing) {
+  expectChoice(renderAuto(test::projectScene("failure/caustic.obj"), ""), "lt", 4);
+}
+
+// With a constant environment nothing starts at the lights alone: three pilots.
+TEST(MethodChoiceCli, AnEnvironmentLeavesLightTracingOut) {
+  const AutoRender r = renderAuto(test::projectScene("cornell-box/CornellBox-Original.obj"), "--env 0.2,0.2,0.2");
+  ASSERT_EQ(r.run.exitCode, 0) << r.run.output;
+  EXPECT_EQ(r.stats["method_choice"]["methods"].size(), 3u);
+  EXPECT_FALSE(r.stats["method_choice"]["methods"].contains("lt"));
+}
+
+// The pilots are apart from the render: its image is the chosen method's for the seed.
+TEST(MethodChoiceCli, TheImageIsTheChosenMethodsImageForTheSeed) {
+  const std::string scene = test::projectScene("failure/caustic.obj");
+  const AutoRender r = renderAuto(scene, "--seed 5");
+  ASSERT_EQ(r.run.exitCode, 0) << r.run.output;
+  const std::string method = r.stats["method"];
+  const std::string dir = test::tempDir("auto");
+  const auto plain = test::runFredholm("render " + scene + " --method " + method +
+                                       " --width 128 --height 128 --spp 1 --seed 5 -o " + dir + "/plain.exr");
+  ASSERT_EQ(plain.exitCode, 0) << plain.output;
+  EXPECT_EQ(readImage(r.image).rgb, readImage(dir + "/plain.exr").rgb) << method;
+}
+
+TEST(MethodChoiceCli, WhatAutoCannotGoWithIsAnErrorBeforeAnyWork) {
+  const std::string dir = test::tempDir("auto");
+  const std::string scene = test::projectScene("cornell-box/CornellBox-Original.obj");
+  const std::pair<std::string, std::string> cases[] = {
+      {"--passes 0:4 --film " + dir + "/chunk.film", "--passes (every chunk must have the method of the others)"},
+      {"--resume " + dir + "/none.film", "--resume (the checkpoint's render chose its method already"},
+      {"--aov albedo", "--aov (a debug view has no method)"}};
+  for (const auto& [flags, why] : cases) {
+    const auto r = test::runFredholm("render " + scene + " --method auto --width 8 --height 8 -o " + dir +
+                                     "/x.exr " + flags);
+    EXPECT_NE(r.exitCode, 0) << flags;
+    EXPECT_NE(r.output.find("fredholm: error: --method auto chooses a method per render and does not go with " + why),
+              std::string::npos)
+        << r.output;
+    EXPECT_EQ(r.output.find("pilot"), std::string::npos) << "work began: " << r.output;
+  }
+}
+
+}  // namespace
+}  // namespace fh
