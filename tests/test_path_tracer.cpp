@@ -997,6 +997,31 @@ TEST(LightTracing, AgreesWithMisWhereShadingNormalsLeanTowardGrazingLight) {
               renderWithMethod(scene, Method::MIS, 24, 256, 16).film, "leaning normals: lt vs mis");
 }
 
+// A floor under a glossy coat (Schlick's Fresnel from F0 = 0.5: half the light is left to the
+// diffuse lobe seen head-on, a fifth at grazing) lit at grazing angles, and the ceiling it
+// lights, seen from below. The diffuse share is taken at the outgoing direction, so light
+// tracing must evaluate each bounce's BSDF the other way round from a camera path's:
+// evaluated with the light's direction as the outgoing one, the floor would send the ceiling
+// less than half of what it does.
+TEST(LightTracing, AgreesWithMisWhereTheDiffuseShareDependsOnTheOutgoingDirection) {
+  SceneBuilder b;
+  const int coated = b.material(0.8f);
+  b.quadFacing({-3, 0, -3}, {3, 0, -3}, {3, 0, 3}, {-3, 0, 3}, {0, 1, 0}, coated);                // floor
+  b.quadFacing({-3, 1.2f, -3}, {3, 1.2f, -3}, {3, 1.2f, 3}, {-3, 1.2f, 3}, {0, 0, 0}, b.material(0.8f));  // ceiling
+  b.quadFacing({-3.5f, 0.05f, -3}, {-3.5f, 0.05f, 3}, {-3.5f, 0.3f, 3}, {-3.5f, 0.3f, -3}, {0, 0.2f, 0},  // light
+               b.material(0.f, 5.f));
+  Scene scene = b.build();
+  Material& coat = scene.materials[size_t(coated)];
+  coat.ks = {0.5f, 0.5f, 0.5f};
+  coat.ns = 10.f;
+  scene.camera.eye = {0.f, 0.3f, 3.f};
+  scene.camera.target = {0.f, 1.2f, -1.f};
+  scene.camera.up = {0, 1, 0};
+  scene.camera.fovYDeg = 50.f;
+  expectAgree(renderWithMethod(scene, Method::LT, 24, 256, 17).film,
+              renderWithMethod(scene, Method::MIS, 24, 256, 18).film, "coated floor: lt vs mis");
+}
+
 // The caustic scene (a glass ball focusing a small light on the floor), where every camera
 // method finds the caustic by BSDF sampling alone: light tracing connects it from the
 // floor, so at equal samples its image variance is a fraction of mis's.
