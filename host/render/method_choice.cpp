@@ -22,7 +22,9 @@ std::string MethodChoice::describeCosts() const {
 }
 
 std::vector<Method> methodsFor(const Scene& scene, const RenderSettings& s) {
-  std::vector<Method> methods = {Method::PT, Method::NEE, Method::MIS};
+  std::vector<Method> methods;
+  if (scene.lights.empty() && !s.envMap) methods.push_back(Method::PT);
+  methods.insert(methods.end(), {Method::NEE, Method::MIS});
   const bool environment = s.env != std::array<float, 3>{0.f, 0.f, 0.f} || s.envMap;
   if (!scene.lights.empty() && !environment && !s.adaptive && !s.surfaceAovs) methods.push_back(Method::LT);
   return methods;
@@ -37,17 +39,29 @@ Method cheapestMethod(const std::vector<MethodTrial>& trials) {
   return best->cost() < kChoiceMargin * mis->cost() ? best->method : Method::MIS;
 }
 
+PilotSize pilotSize(double samples, int imageSide) {
+  PilotSize size;
+  const int largest = std::max(1, std::min(kMaxPilotSide, imageSide));
+  // Square pixels count: the side's square bounds the pixels whatever the aspect.
+  const double side = std::sqrt(std::max(samples, 0.0) / kMinPilotSpp);
+  size.side = std::clamp(int(side), std::min(kMinPilotSide, largest), largest);
+  const double passes = samples / (double(size.side) * size.side);
+  size.passes = int(std::clamp(passes, double(kMinPilotSpp), double(kMaxPilotSpp)));
+  return size;
+}
+
 namespace {
 
-// The render's settings for a pilot of `method`: the image scaled down (its aspect kept), a
-// fixed pass count with two replicates for the noise estimate, nothing saved or shown.
-RenderSettings pilotSettings(const RenderSettings& s, Method method) {
+// The render's settings for a pilot of `method`: the image scaled to `side` pixels on its
+// longer side (its aspect kept), `passes` passes with two replicates for the noise estimate,
+// nothing saved or shown.
+RenderSettings pilotSettings(const RenderSettings& s, Method method, int side, int passes) {
   RenderSettings p = s;
-  const double scale = std::min(1.0, double(kPilotSide) / double(std::max(s.width, s.height)));
+  const double scale = std::min(1.0, double(side) / double(std::max(s.width, s.height)));
   p.width = std::max(1, int(std::lround(s.width * scale)));
   p.height = std::max(1, int(std::lround(s.height * scale)));
   p.method = method;
-  p.spp = kPilotSpp;
+  p.spp = passes;
   p.firstPass = 0;
   p.seconds = 0.0;
   // A target no image meets but a black one: two replicates, and every pass rendered.
@@ -65,8 +79,21 @@ MethodChoice chooseMethod(const std::vector<DeviceInfo>& devices, const Scene& s
   MethodChoice choice;
   RenderLinks links;
   links.stop = stop;
-  for (Method method : methodsFor(scene, s)) {
-    const RenderSettings p = pilotSettings(s, method);
+  const std::vector<Method> methods = methodsFor(scene, s);
+  // mis's samples per second, from a short render (its first pass, compiling and waiting on
+  // the others, not counted), and so the render's expected time and the pilots' samples.
+  const RenderSettings timing = pilotSettings(s, Method::MIS, kMaxPilotSide / 2, int(kNoiseMinPasses));
+  const RenderResult timed = render(devices, scene, bvh, camera, timing, links);
+  const double perSecond = timed.stats.steadySamplesPerSecond > 0 ? timed.stats.steadySamplesPerSecond
+                                                                  : double(timed.stats.samples) / timed.stats.seconds;
+  const double atMisSpeed = double(s.width) * s.height * s.spp / perSecond;
+  const double renderSeconds = s.seconds > 0 ? std::min(s.seconds, atMisSpeed) : atMisSpeed;
+  const PilotSize size =
+      pilotSize(kPilotShare * renderSeconds * perSecond / double(methods.size()), std::max(s.width, s.height));
+  choice.pilotSpp = size.passes;
+  for (Method method : methods) {
+    if (links.stopRequested()) break;
+    const RenderSettings p = pilotSettings(s, method, size.side, size.passes);
     choice.pilotWidth = p.width;
     choice.pilotHeight = p.height;
     const RenderResult r = render(devices, scene, bvh, camera, p, links);

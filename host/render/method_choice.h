@@ -19,10 +19,17 @@ namespace fh {
 
 // Another method is chosen over mis only where its pilot cost is below this share of mis's.
 constexpr double kChoiceMargin = 0.8;
-// The pilot: the image scaled down to at most this many pixels a side, at this many passes
-// (enough for the noise estimate, whose two halves need kNoiseMinPasses between them).
-constexpr int kPilotSide = 128;
-constexpr int kPilotSpp = 64;
+// The pilot: each method renders the same image, the render's scaled down (its aspect kept),
+// for the same number of passes, taking about kPilotShare of the render's expected time
+// between them (a short mis render gives mis's samples per second; the render's time is its
+// --time, or its samples at that speed). The budget goes to the image's size first, from
+// kMinPilotSide to kMaxPilotSide pixels on its longer side at kMinPilotSpp passes (enough
+// for the noise estimate, whose halves need kNoiseMinPasses between them), then to passes,
+// up to kMaxPilotSpp. A longer pilot sees more of a heavy-tailed method's rare samples:
+// the longer the render, the surer its choice.
+constexpr double kPilotShare = 0.1;
+constexpr int kMinPilotSide = 32, kMaxPilotSide = 128;
+constexpr int kMinPilotSpp = 64, kMaxPilotSpp = 1024;
 
 struct MethodTrial {
   Method method = Method::MIS;
@@ -33,21 +40,29 @@ struct MethodTrial {
 
 struct MethodChoice {
   Method method = Method::MIS;
-  int pilotWidth = 0, pilotHeight = 0, pilotSpp = kPilotSpp;
+  int pilotWidth = 0, pilotHeight = 0, pilotSpp = 0;
   double seconds = 0.0;  // the whole pilot, set-up included
   std::vector<MethodTrial> trials;
   // "pt 3.3e-02, nee 7.7e-03, mis 8.4e-03, lt 5.5e-03": each trial's cost.
   std::string describeCosts() const;
 };
 
-// The methods that can render the scene with these settings: pt, nee and mis always; lt
-// where the scene has emitting triangles and nothing it cannot do is asked (an environment,
-// adaptive passes, first-surface layers).
+// The methods worth a pilot with these settings: nee and mis always; pt only where nothing
+// can be sampled as a light (no emitting triangle, no --env-map: mis is then pt with
+// shadow rays that find nothing); lt where the scene has emitting triangles and nothing it
+// cannot do is asked (an environment, adaptive passes, first-surface layers).
 std::vector<Method> methodsFor(const Scene& scene, const RenderSettings& s);
 
 // Of the trials, the method the render should use: the cheapest where it beats mis's cost by
 // kChoiceMargin, else mis.
 Method cheapestMethod(const std::vector<MethodTrial>& trials);
+
+// The pilot's longer side and passes for `samples` samples per method, within the bounds
+// above (the side no larger than the image's).
+struct PilotSize {
+  int side = kMinPilotSide, passes = kMinPilotSpp;
+};
+PilotSize pilotSize(double samples, int imageSide);
 
 // Runs the pilots on the render's devices and chooses. `stop` (as RenderLinks::stop) ends
 // the pilot early; the choice is then mis.
