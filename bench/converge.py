@@ -1,16 +1,18 @@
 #!/usr/bin/python3
-"""Error against render time for pt, nee and mis (and mis+denoise: mis with --denoise, the
-denoised image measured and the denoiser's time added): renders a scene at 1, 2, 4, ... spp with
+"""Error against render time for pt, nee, mis and lt (and mis+denoise: mis with --denoise, the
+denoised image measured and the denoiser's time added; auto: --method auto, its pilots' time
+added): renders a scene at 1, 2, 4, ... spp with
 each method, measures each image against a reference (`fredholm compare`: relMSE, RMSE,
 MAE), and writes a CSV and a log-log chart of relMSE against seconds, with a slope -1
 guide (an unbiased estimator's relMSE falls as 1/time).
 
 usage: bench/converge.py [SCENE.obj] [--out DIR] [--width W] [--height H] [--max-spp N]
-                         [--ref REF.exr | --ref-spp N] [--methods pt,nee,mis] [--name NAME]
+                         [--ref REF.exr | --ref-spp N] [--ref-method M] [--methods pt,nee,mis]
+                         [--name NAME]
                          [-- RENDER FLAGS]
 
-Without --ref, the reference is a long `mis` render of fredholm itself (--ref-spp samples,
-default 4096): it cannot reveal a bias fredholm shares with itself, and its own noise is
+Without --ref, the reference is a long render of fredholm itself (--ref-spp samples,
+default 4096, with --ref-method, default mis; lt where a caustic dominates the error): it cannot reveal a bias fredholm shares with itself, and its own noise is
 about relMSE(max-spp run) * max-spp / ref-spp. Needs Debian's python3-matplotlib.
 """
 import argparse
@@ -34,6 +36,8 @@ def render(out, spp, method, seed, args, extra):
     flags = benchlib.image_flags(args) + ["--spp", str(spp), "--method", "mis" if denoise else method,
                                           "--seed", str(seed)] + (["--denoise"] if denoise else []) + extra
     stats = benchlib.render(flags, out, args.binary)
+    if method == "auto":  # the pilots run before the render's clock starts
+        stats["seconds"] += stats["method_choice"]["seconds"]
     if denoise:
         took = re.search(r"fredholm: denoised in ([0-9.]+) s", stats.stderr)
         stats["seconds"] += float(took.group(1))
@@ -79,6 +83,7 @@ def main():
                            out=benchlib.scratch_path("converge"))
     p.add_argument("--max-spp", type=int, default=256)
     benchlib.add_arguments(p, "--ref", "--ref-spp", "--methods")
+    p.add_argument("--ref-method", default="mis", help="the reference's method (default mis)")
     p.add_argument("--name", help="the CSV's and chart's name (default: the scene's)")
     p.add_argument("--from-csv", help="chart an earlier run's CSV again, rendering nothing")
     args, extra = benchlib.parse_with_rest(p)
@@ -93,12 +98,13 @@ def main():
                     for r in csv.DictReader(f)]
         return chart(rows, name, args)
     if not reference:
-        reference = os.path.join(args.out, f"{scene_name}-reference-{args.ref_spp}.exr")
+        suffix = "" if args.ref_method == "mis" else f"-{args.ref_method}"
+        reference = os.path.join(args.out, f"{scene_name}-reference-{args.ref_spp}{suffix}.exr")
         if os.path.exists(reference):  # the same scene, size and spp: made by an earlier chart
             print(f"reference: {reference} (kept)")
         else:
-            stats = render(reference, args.ref_spp, "mis", 1000, args, extra)
-            print(f"reference: mis, {args.ref_spp} spp, {stats['seconds']:.1f} s -> {reference}")
+            stats = render(reference, args.ref_spp, args.ref_method, 1000, args, extra)
+            print(f"reference: {args.ref_method}, {args.ref_spp} spp, {stats['seconds']:.1f} s -> {reference}")
 
     rows = []
     for method in args.methods.split(","):
@@ -111,7 +117,8 @@ def main():
             stats = render(image, spp, method, spp, args, extra)
             err = benchlib.compare(stats.get("image", image), reference, args.binary)
             rows.append({"scene": name, "method": method, "spp": spp, "seconds": stats["seconds"],
-                         "relMSE": err["relmse"], "RMSE": err["rmse"], "MAE": err["mae"]})
+                         "relMSE": err["relmse"], "RMSE": err["rmse"], "MAE": err["mae"],
+                         "chose": stats["method"]})
             print(f"{method:4s} {spp:6d} spp {stats['seconds']:8.2f} s  relMSE {err['relmse']:.3e}")
             spp *= 2
 
@@ -127,7 +134,7 @@ def chart(rows, name, args):
 
     fig, ax = plt.subplots(figsize=(6, 4.5))
     for method, color in (("pt", "tab:blue"), ("nee", "tab:orange"), ("mis", "tab:green"),
-                          ("mis+denoise", "tab:red")):
+                          ("lt", "tab:purple"), ("auto", "black"), ("mis+denoise", "tab:red")):
         pts = [r for r in rows if r["method"] == method]
         if pts:
             ax.loglog([r["seconds"] for r in pts], [r["relMSE"] for r in pts], "o-", color=color, label=method)

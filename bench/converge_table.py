@@ -15,7 +15,7 @@ import os
 
 import benchlib
 
-METHODS = ("pt", "nee", "mis")
+METHODS = ("pt", "nee", "mis", "lt", "auto")
 
 
 def read_rows(path):
