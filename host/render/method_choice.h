@@ -27,7 +27,7 @@ constexpr double kChoiceMargin = 0.8;
 // for the noise estimate, whose halves need kNoiseMinPasses between them), then to passes,
 // up to kMaxPilotSpp. A longer pilot sees more of a heavy-tailed method's rare samples:
 // the longer the render, the surer its choice.
-constexpr double kPilotShare = 0.1;
+constexpr double kPilotShare = 0.05;
 constexpr int kMinPilotSide = 32, kMaxPilotSide = 128;
 constexpr int kMinPilotSpp = 64, kMaxPilotSpp = 1024;
 
