@@ -33,10 +33,13 @@ std::vector<ProgramSpec> everyProgramVariant() {
   for (Strategy strategy : {Strategy::Scalar, Strategy::Megakernel8})
     for (const SceneFeatures& features : {SceneFeatures{}, SceneFeatures::all()})
       programs.push_back(pathTracerProgram(features, Method::PT, traversal, strategy, true));
-  // Light tracing (--method lt): its kernel for every material feature, and its camera
-  // paths (mis keeping those that leave the first vertex by a delta lobe) with glass and mirrors.
-  for (unsigned bits = 0; bits < 16; ++bits)
-    programs.push_back(lightTracerProgram({(bits & 1) != 0, (bits & 2) != 0, (bits & 4) != 0, (bits & 8) != 0}, traversal));
+  // Light tracing (--method lt) and bidirectional path tracing (bdpt): their kernels for every
+  // material feature, and lt's camera paths (mis keeping those that leave the first vertex by
+  // a delta lobe) with glass and mirrors.
+  for (Method method : {Method::LT, Method::BDPT})
+    for (unsigned bits = 0; bits < 16; ++bits)
+      programs.push_back(
+          lightTracerProgram(method, {(bits & 1) != 0, (bits & 2) != 0, (bits & 4) != 0, (bits & 8) != 0}, traversal));
   for (Strategy strategy : {Strategy::Scalar, Strategy::Simd8, Strategy::Megakernel8})
     programs.push_back(pathTracerProgram(SceneFeatures::all(), Method::LT, traversal, strategy));
   return programs;

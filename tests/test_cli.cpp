@@ -20,7 +20,7 @@ namespace {
 TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
   const std::string dir = test::tempDir("cli");
   const std::pair<const char*, const char*> cases[] = {
-      {"--method foo", "--method 'foo': unknown method (use pt, nee, mis, lt or auto)"},
+      {"--method foo", "--method 'foo': unknown method (use pt, nee, mis, lt, bdpt or auto)"},
       {"--filter tent", "--filter 'tent': unknown filter"},
       {"--env 1,1,x", "--env '1,1,x': 'x' is not a number"},
       {"--aov shiny", "--aov 'shiny': unknown output"},
@@ -42,9 +42,9 @@ TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
       {"--strategy vector", "--strategy 'vector': unknown strategy (use auto, scalar, simd8, megakernel or megakernel8)"},
       {"--rr-depth 0", "--rr-depth must be at least 1"},
       // What light tracing cannot do yet, named before any work.
-      {"--method lt --env 1,1,1", "--method lt traces paths from the emitting triangles only and does not go with --env;"},
+      {"--method lt --env 1,1,1", "--method lt traces light paths from the emitting triangles only and does not go with --env;"},
       {"--method lt --env-map /nonexistent/sky.exr", "does not go with --env-map; use mis"},
-      {"--method lt --adaptive", "--method lt traces paths from the emitting triangles only and does not go with --adaptive"},
+      {"--method lt --adaptive", "--method lt traces light paths from the emitting triangles only and does not go with --adaptive"},
       {"--method lt --aovs albedo,spp", "--method lt records no first surfaces, which --aovs 'albedo,spp' asks for"},
       {"--method lt --denoise", "--method lt records no first surfaces, which --denoise needs"},
   };

@@ -54,16 +54,20 @@ TEST(Mpi, EveryRankCountGivesTheImageOfOneProcess) {
   }
 }
 
-// Light tracing's splats (render/light_tracer.h) merge as exactly across ranks.
+// Light tracing's and bidirectional path tracing's splats (render/light_tracer.h) merge as
+// exactly across ranks.
 TEST(Mpi, LightTracingOnThreeRanksGivesTheImageOfOneProcess) {
-  const std::string dir = test::tempDir("mpi");
-  const std::string args = "render " + test::projectScene("failure/caustic.obj") +
-                           " --method lt --width 24 --height 16 --seed 4 --spp 12 --force -o " + dir;
-  const auto alone = test::runFredholm(args + "/alone.exr");
-  ASSERT_EQ(alone.exitCode, 0) << alone.output;
-  const auto r = mpirun(3, args + "/np3.exr");
-  ASSERT_EQ(r.exitCode, 0) << r.output;
-  EXPECT_TRUE(test::exrChannels(dir + "/np3.exr") == test::exrChannels(dir + "/alone.exr"));
+  for (const std::string method : {"lt", "bdpt"}) {
+    SCOPED_TRACE(method);
+    const std::string dir = test::tempDir("mpi-" + method);
+    const std::string args = "render " + test::projectScene("failure/caustic.obj") + " --method " + method +
+                             " --width 24 --height 16 --seed 4 --spp 12 --force -o " + dir;
+    const auto alone = test::runFredholm(args + "/alone.exr");
+    ASSERT_EQ(alone.exitCode, 0) << alone.output;
+    const auto r = mpirun(3, args + "/np3.exr");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_TRUE(test::exrChannels(dir + "/np3.exr") == test::exrChannels(dir + "/alone.exr"));
+  }
 }
 
 TEST(Mpi, ASlowedRankTakesFewerPasses) {

@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "accel/bvh.h"
+#include "base/test_hooks.h"
 #include "render/device_scene.h"
 #include "render/pixel_filter.h"
 #include "render/render.h"
@@ -874,35 +875,14 @@ TEST(WhereMethodsFail, GrazingAngles) {
   }
 }
 
-// ---- Light tracing (--method lt, render/light_tracer.h) ----
-// Light paths connected to the camera and splatted where it sees them, beside camera paths
-// for what is seen through a delta lobe: the closed forms above, and mis's image wherever
-// the adjoint differs from radiance transport (refraction's 1/eta^2, shading normals, the
-// diffuse share that depends on the outgoing direction) and under every pixel filter.
-
-TEST(LightTracing, ClosedFurnaceBoxIsLeOverOneMinusRho) { expectClosedFurnace(Method::LT); }
-
-TEST(LightTracing, PlaneUnderRectangularEmitterFollowsLambertsFormula) {
-  expectLambertsPlane(PlaneUnderLight::scene(), Method::LT, "lt");
-  expectLambertsPlane(planeWithNormalsAgainstTheWinding(), Method::LT, "lt, normals against the winding");
-}
-
-// The same plane under a light 4096 times as bright: the pixels that see the light gather
-// more than 2^32 film quanta in a pass, so each splat's carry out of the low word counts.
-TEST(LightTracing, SplatsPastTwoToTheThirtyTwoQuantaCarry) {
-  const double scale = 4096;
-  Scene scene = PlaneUnderLight::scene();
-  for (Material& m : scene.materials) m.ke = m.ke * float(scale);
-  scene.lights.clear();
-  collectLights(scene);
-  RenderSettings s = test::renderSettings();
-  s.method = Method::LT;
-  s.width = s.height = 24;
-  s.spp = 64;
-  const RenderResult r = test::render(scene, scene.camera, s);
-  const Image exact = PlaneUnderLight::reference(scene.camera, 24, 24, 8, true);
-  expectMatches(r.film, [&](size_t p) { return scale * double(exact.rgb[3 * p]); }, "lt, a bright light");
-}
+// ---- Light paths: light tracing (--method lt) and bidirectional path tracing (bdpt) ----
+// (render/light_tracer.h) Light paths connected to the camera and splatted where it sees
+// them, beside camera paths (lt: for what is seen through a delta lobe; bdpt: every camera
+// subpath, joined to the light subpath with power-heuristic weights): the closed forms
+// above, and mis's image wherever the adjoint differs from radiance transport (refraction's
+// 1/eta^2, shading normals, the diffuse share that depends on the outgoing direction) and
+// under every pixel filter. bdpt's weights must sum to one over its strategies for every
+// path, or these images drift from mis's and the closed forms.
 
 RenderResult renderWithMethod(const Scene& scene, Method method, int size, int spp, unsigned seed,
                               PixelFilter filter = PixelFilter::Box) {
@@ -917,31 +897,60 @@ RenderResult renderWithMethod(const Scene& scene, Method method, int size, int s
   return r;
 }
 
+class LightTracing : public ::testing::TestWithParam<Method> {
+ protected:
+  static std::string name() { return methodName(GetParam()); }
+};
+
+TEST_P(LightTracing, ClosedFurnaceBoxIsLeOverOneMinusRho) { expectClosedFurnace(GetParam()); }
+
+TEST_P(LightTracing, PlaneUnderRectangularEmitterFollowsLambertsFormula) {
+  expectLambertsPlane(PlaneUnderLight::scene(), GetParam(), name());
+  expectLambertsPlane(planeWithNormalsAgainstTheWinding(), GetParam(), name() + ", normals against the winding");
+}
+
+// The same plane under a light 4096 times as bright: the pixels that see the light gather
+// more than 2^32 film quanta in a pass, so each splat's carry out of the low word counts.
+TEST_P(LightTracing, SplatsPastTwoToTheThirtyTwoQuantaCarry) {
+  const double scale = 4096;
+  Scene scene = PlaneUnderLight::scene();
+  for (Material& m : scene.materials) m.ke = m.ke * float(scale);
+  scene.lights.clear();
+  collectLights(scene);
+  RenderSettings s = test::renderSettings();
+  s.method = GetParam();
+  s.width = s.height = 24;
+  s.spp = 64;
+  const RenderResult r = test::render(scene, scene.camera, s);
+  const Image exact = PlaneUnderLight::reference(scene.camera, 24, 24, 8, true);
+  expectMatches(r.film, [&](size_t p) { return scale * double(exact.rgb[3 * p]); }, name() + ", a bright light");
+}
+
 // Glass spheres and water (refraction, with vertex normals), a mirror sphere, and the light
 // seen through them: what the camera paths add and what the light paths splat.
-TEST(LightTracing, AgreesWithMisThroughGlassMirrorsAndVertexNormals) {
+TEST_P(LightTracing, AgreesWithMisThroughGlassMirrorsAndVertexNormals) {
   const Scene scene = loadScene(test::projectScene("cornell-box/CornellBox-Water.obj"));
-  const RenderResult lt = renderWithMethod(scene, Method::LT, 32, 256, 3);
-  expectAgree(lt.film, renderWithMethod(scene, Method::MIS, 32, 256, 4).film, "water box: lt vs mis", 8);
+  const RenderResult lt = renderWithMethod(scene, GetParam(), 32, 256, 3);
+  expectAgree(lt.film, renderWithMethod(scene, Method::MIS, 32, 256, 4).film, "water box: " + name() + " vs mis", 8);
   EXPECT_GT(lt.stats.cameraRays, 0u) << "no camera paths for what is seen through glass";
 }
 
-TEST(LightTracing, AgreesWithMisOnGlossySurfacesAndUnderEveryFilter) {
+TEST_P(LightTracing, AgreesWithMisOnGlossySurfacesAndUnderEveryFilter) {
   const Scene glossy = loadScene(test::projectScene("cornell-box/legacy-glossy-2011/CornellBox-Glossy.obj"));
-  expectAgree(renderWithMethod(glossy, Method::LT, 32, 256, 5).film,
-              renderWithMethod(glossy, Method::MIS, 32, 256, 6).film, "glossy box: lt vs mis", 8);
+  expectAgree(renderWithMethod(glossy, GetParam(), 32, 256, 5).film,
+              renderWithMethod(glossy, Method::MIS, 32, 256, 6).film, "glossy box: " + name() + " vs mis", 8);
   const Scene box = loadDefaultScene();
   for (PixelFilter filter : {PixelFilter::Gaussian, PixelFilter::BlackmanHarris})
-    expectAgree(renderWithMethod(box, Method::LT, 24, 256, 7, filter).film,
+    expectAgree(renderWithMethod(box, GetParam(), 24, 256, 7, filter).film,
                 renderWithMethod(box, Method::MIS, 24, 256, 8, filter).film,
-                std::string("Cornell box, ") + filterName(filter) + ": lt vs mis");
+                std::string("Cornell box, ") + filterName(filter) + ": " + name() + " vs mis");
 }
 
 // The camera and a floor under a sheet of glass (the medium below it), the light above:
 // light paths cross one interface into the camera's medium. Radiance is scaled by eta^2 there
 // and importance is not; a light tracer that carried radiance's 1/eta^2 would see the floor
 // 2.25 times too dark. (Through a closed object the two factors cancel.)
-TEST(LightTracing, AgreesWithMisWhereLightEntersTheCamerasMedium) {
+TEST_P(LightTracing, AgreesWithMisWhereLightEntersTheCamerasMedium) {
   SceneBuilder b;
   const float big = 20.f;
   b.quadFacing({-big, 0, -big}, {big, 0, -big}, {big, 0, big}, {-big, 0, big}, {0, 1, 0}, b.material(0.5f));
@@ -952,15 +961,15 @@ TEST(LightTracing, AgreesWithMisWhereLightEntersTheCamerasMedium) {
   scene.camera.target = {0.f, 0.f, 0.f};
   scene.camera.up = {0, 1, 0};
   scene.camera.fovYDeg = 60.f;
-  expectAgree(renderWithMethod(scene, Method::LT, 24, 256, 11).film,
-              renderWithMethod(scene, Method::MIS, 24, 256, 12).film, "floor under glass: lt vs mis");
+  expectAgree(renderWithMethod(scene, GetParam(), 24, 256, 11).film,
+              renderWithMethod(scene, Method::MIS, 24, 256, 12).film, "floor under glass: " + name() + " vs mis");
 }
 
 // The Cornell box with every vertex normal tilted 27 degrees off its face's: light tracing
 // weighs the connection to the camera and each bounce by the shading normal's cosine at
 // the incoming side over the geometric one (Veach 1997, section 5.3), or it would light
 // the walls by their faces' normals where camera paths light them by the tilted ones.
-TEST(LightTracing, AgreesWithMisUnderTiltedVertexNormals) {
+TEST_P(LightTracing, AgreesWithMisUnderTiltedVertexNormals) {
   Scene scene = loadDefaultScene();
   scene.cornerNormals.clear();
   for (size_t t = 0; t < scene.triangleCount(); ++t) {
@@ -969,14 +978,14 @@ TEST(LightTracing, AgreesWithMisUnderTiltedVertexNormals) {
     const Vec3f tilted = normalize(front + normalize(cross(front, Vec3f{0.3f, 0.5f, 0.8f})) * 0.5f);
     for (int k = 0; k < 3; ++k) scene.cornerNormals.insert(scene.cornerNormals.end(), tilted.begin(), tilted.end());
   }
-  expectAgree(renderWithMethod(scene, Method::LT, 24, 256, 13).film,
-              renderWithMethod(scene, Method::MIS, 24, 256, 14).film, "tilted normals: lt vs mis");
+  expectAgree(renderWithMethod(scene, GetParam(), 24, 256, 13).film,
+              renderWithMethod(scene, Method::MIS, 24, 256, 14).film, "tilted normals: " + name() + " vs mis");
 }
 
 // Light grazing a floor whose vertex normals lean 40 degrees toward it: the floor sends on
 // about three times what its faces' normal would say (|ns.w_in| / |ng.w_in|), and the wall
 // it lights shows whether each bounce of a light path is weighed that way.
-TEST(LightTracing, AgreesWithMisWhereShadingNormalsLeanTowardGrazingLight) {
+TEST_P(LightTracing, AgreesWithMisWhereShadingNormalsLeanTowardGrazingLight) {
   SceneBuilder b;
   b.quadFacing({-3, 0, -3}, {3, 0, -3}, {3, 0, 3}, {-3, 0, 3}, {0, 1, 0}, b.material(0.8f));          // floor
   b.quadFacing({-3, 0, -3}, {3, 0, -3}, {3, 3, -3}, {-3, 3, -3}, {0, 1, 0}, b.material(0.8f));         // back wall
@@ -993,8 +1002,8 @@ TEST(LightTracing, AgreesWithMisWhereShadingNormalsLeanTowardGrazingLight) {
   scene.camera.target = {0.f, 1.f, -3.f};
   scene.camera.up = {0, 1, 0};
   scene.camera.fovYDeg = 50.f;
-  expectAgree(renderWithMethod(scene, Method::LT, 24, 256, 15).film,
-              renderWithMethod(scene, Method::MIS, 24, 256, 16).film, "leaning normals: lt vs mis");
+  expectAgree(renderWithMethod(scene, GetParam(), 24, 256, 15).film,
+              renderWithMethod(scene, Method::MIS, 24, 256, 16).film, "leaning normals: " + name() + " vs mis");
 }
 
 // A floor under a glossy coat (Schlick's Fresnel from F0 = 0.5: half the light is left to the
@@ -1003,7 +1012,7 @@ TEST(LightTracing, AgreesWithMisWhereShadingNormalsLeanTowardGrazingLight) {
 // tracing must evaluate each bounce's BSDF the other way round from a camera path's:
 // evaluated with the light's direction as the outgoing one, the floor would send the ceiling
 // less than half of what it does.
-TEST(LightTracing, AgreesWithMisWhereTheDiffuseShareDependsOnTheOutgoingDirection) {
+TEST_P(LightTracing, AgreesWithMisWhereTheDiffuseShareDependsOnTheOutgoingDirection) {
   SceneBuilder b;
   const int coated = b.material(0.8f);
   b.quadFacing({-3, 0, -3}, {3, 0, -3}, {3, 0, 3}, {-3, 0, 3}, {0, 1, 0}, coated);                // floor
@@ -1018,20 +1027,59 @@ TEST(LightTracing, AgreesWithMisWhereTheDiffuseShareDependsOnTheOutgoingDirectio
   scene.camera.target = {0.f, 1.2f, -1.f};
   scene.camera.up = {0, 1, 0};
   scene.camera.fovYDeg = 50.f;
-  expectAgree(renderWithMethod(scene, Method::LT, 24, 256, 17).film,
-              renderWithMethod(scene, Method::MIS, 24, 256, 18).film, "coated floor: lt vs mis");
+  expectAgree(renderWithMethod(scene, GetParam(), 24, 256, 17).film,
+              renderWithMethod(scene, Method::MIS, 24, 256, 18).film, "coated floor: " + name() + " vs mis");
 }
 
 // The caustic scene (a glass ball focusing a small light on the floor), where every camera
 // method finds the caustic by BSDF sampling alone: light tracing connects it from the
 // floor, so at equal samples its image variance is a fraction of mis's.
-TEST(LightTracing, RendersTheCausticWithAFractionOfMissVariance) {
+TEST_P(LightTracing, RendersTheCausticWithAFractionOfMissVariance) {
   const Scene scene = loadScene(test::projectScene("failure/caustic.obj"));
-  const RenderResult lt = renderWithMethod(scene, Method::LT, 32, 256, 9);
+  const RenderResult lt = renderWithMethod(scene, GetParam(), 32, 256, 9);
   const RenderResult mis = renderWithMethod(scene, Method::MIS, 32, 256, 10);
-  expectAgree(lt.film, mis.film, "caustic: lt vs mis", 8);
+  expectAgree(lt.film, mis.film, "caustic: " + name() + " vs mis", 8);
   EXPECT_LT(imageVariance(lt.film), 0.25 * imageVariance(mis.film))
       << "variance lt " << imageVariance(lt.film) << " mis " << imageVariance(mis.film);
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, LightTracing, ::testing::Values(Method::LT, Method::BDPT),
+                         methodParamName);
+
+// ---- Bidirectional path tracing's strategies, each alone ----
+// With the test hook's one strategy per path length at weight one (kernels/bdpt.cl,
+// FH_BDPT_ONLY_S), bdpt is an unweighted estimator: the camera subpath alone (s = 0),
+// light sampled by area (s = 1), light tracing then connections to the first light vertex
+// (s = 2), and to the second (s = 3). Each must reach the closed forms alone, which the
+// weighted images cannot show: a strategy's wrong contribution would hide under a weight
+// that keeps it small.
+TEST(Bidirectional, EachStrategyAloneReachesTheClosedForms) {
+  for (int only : {0, 1, 2, 3}) {
+    TestHooks hooks = testHooks();
+    hooks.bdptOnlyLightVertices = only;
+    const ScopedTestHooks strategy(hooks);
+    const std::string what = "bdpt, only s = " + std::to_string(only);
+    SCOPED_TRACE(what);
+    expectClosedFurnace(Method::BDPT);
+    expectLambertsPlane(PlaneUnderLight::scene(), Method::BDPT, what);
+  }
+}
+
+// More bounces than a pass's light vertices fit in one buffer: bdpt launches a part of the
+// paths at a time (render/light_tracer.cpp), every part's light vertices in the same buffer.
+TEST(Bidirectional, PassesInSeveralLaunchesAgreeWithMis) {
+  const Scene box = loadDefaultScene();
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = 24;
+  s.spp = 256;
+  s.maxDepth = 4096;  // a 32 MiB buffer holds the vertices of 170 paths
+  s.method = Method::BDPT;
+  s.seed = 19;
+  const RenderResult bdpt = test::render(box, box.camera, s);
+  EXPECT_EQ(bdpt.stats.nonfinite, 0u);
+  s.method = Method::MIS;
+  s.seed = 20;
+  expectAgree(bdpt.film, test::render(box, box.camera, s).film, "Cornell box, 4096 bounces: bdpt vs mis");
 }
 
 }  // namespace

@@ -29,6 +29,12 @@ struct TestHooks {
   // (tests/test_support.cpp parses it; CTest runs each suite under several,
   // tests/CMakeLists.txt); empty: the device's own. fredholm itself never reads it.
   std::string testStrategy;
+
+  // In-process only (no variable): bdpt keeps, for each path, only the contribution of the
+  // strategy with this many light vertices (kernels/bdpt.cl, FH_BDPT_ONLY_S), weight one, so
+  // each strategy's estimator can be tested alone; -1: all of them, weighted. Used by
+  // tests/test_path_tracer.cpp.
+  int bdptOnlyLightVertices = -1;
 };
 
 // The hooks, parsed from the environment on first use. A malformed value is an Error that

@@ -16,7 +16,8 @@ Method parseMethod(const std::string& name) {
   if (name == "nee") return Method::NEE;
   if (name == "mis") return Method::MIS;
   if (name == "lt") return Method::LT;
-  throw Error("--method '" + name + "': unknown method (use pt, nee, mis, lt or auto)");
+  if (name == "bdpt") return Method::BDPT;
+  throw Error("--method '" + name + "': unknown method (use pt, nee, mis, lt, bdpt or auto)");
 }
 
 Strategy parseStrategy(const std::string& name) {

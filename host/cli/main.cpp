@@ -42,7 +42,7 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
   rendering->add_option("--height", o.height, "Image height in pixels")->capture_default_str();
   rendering->add_option("--spp", o.spp, "Samples per pixel (default 64; with --time, the most to take)");
   rendering->add_option("--time", o.seconds, "Time budget in seconds (finishes the pass running then)");
-  rendering->add_option("--method", o.method, "pt (BRDF sampling), nee (light sampling), mis (both), lt (light tracing) or auto (a pilot render with each, then the one with the least error per second)")
+  rendering->add_option("--method", o.method, "pt (BRDF sampling), nee (light sampling), mis (both), lt (light tracing), bdpt (bidirectional) or auto (a pilot render with each, then the one with the least error per second)")
       ->capture_default_str();
   rendering->add_option("--noise", o.noise,
                         "Stop once the image's relMSE, estimated from two independently scrambled halves of the "

@@ -120,8 +120,8 @@ void lightTracingFits(const RenderOptions& o, const RenderSettings& s) {
   else if (!o.envMap.empty()) why = "--env-map";
   else if (o.adaptive) why = "--adaptive (its passes cover chosen pixels; a light path lands anywhere)";
   if (why)
-    throw Error(std::string("--method lt traces paths from the emitting triangles only and does not go with ") + why +
-                "; use mis");
+    throw Error(std::string("--method ") + methodName(s.method) +
+                " traces light paths from the emitting triangles only and does not go with " + why + "; use mis");
 }
 
 // --method auto pilots each method in this process, on this process's devices: what must
@@ -133,7 +133,7 @@ void autoFits(const RenderOptions& o) {
       {!o.aov.empty(), "--aov (a debug view has no method)"}};
   for (const auto& [given, flag] : clashes)
     if (given) throw Error(std::string("--method auto chooses a method per render and does not go with ") + flag +
-                           "; give the method (pt, nee, mis or lt)");
+                           "; give the method (pt, nee, mis, lt or bdpt)");
 }
 
 // --seed: the sampler's seed is 32 bits.
@@ -155,7 +155,7 @@ RenderSettings settingsFrom(const RenderOptions& o) {
   s.filter = parseFilter(o.filter);
   if (!o.env.empty()) s.env = parseVec3Flag("--env", o.env);
   if (s.env[0] < 0 || s.env[1] < 0 || s.env[2] < 0) throw Error("--env '" + o.env + "': radiance cannot be negative");
-  if (s.method == Method::LT) lightTracingFits(o, s);  // before a map is read
+  if (tracesLightPaths(s.method)) lightTracingFits(o, s);  // before a map is read
   s.envMap = environmentMapFrom(o);
   if (o.width <= 0 || o.height <= 0) throw Error("--width/--height must be positive");
   // Pixels are indexed in 32 bits on the device, with room for several pass buffers.
@@ -234,10 +234,12 @@ std::vector<std::string> planOutputs(RenderOptions& o, RenderSettings& settings,
   const std::vector<std::string> layers = o.aovs.empty() ? std::vector<std::string>{} : parseAovLayers(o.aovs);
   if (!o.aov.empty() && !layers.empty()) throw Error("--aov (a debug view) and --aovs (layers beside the image): pick one");
   for (const auto& layer : layers) settings.surfaceAovs |= isSurfaceAov(layer);
-  if (settings.method == Method::LT && (settings.surfaceAovs || o.denoise))
-    throw Error("--method lt records no first surfaces, which " +
+  if (tracesLightPaths(settings.method) && (settings.surfaceAovs || o.denoise))
+    throw Error(std::string("--method ") + methodName(settings.method) + " records no first surfaces, which " +
                 (settings.surfaceAovs ? "--aovs '" + o.aovs + "' asks for" : std::string("--denoise needs")) +
-                " (camera paths see them, light paths do not); use mis");
+                (settings.method == Method::LT ? " (camera paths see them, light paths do not)"
+                                               : " (its camera paths record no layers)") +
+                "; use mis");
   // An explicit -o is never overwritten without --force; the default name steps aside.
   // With --film the film is the output, and an image is written only where -o asks.
   const bool defaultName = o.output.empty() && o.film.empty();

@@ -2,6 +2,9 @@
 // film's pass samples.
 #include "render/light_tracer.h"
 
+#include <algorithm>
+
+#include "base/test_hooks.h"
 #include "render/kernel_arguments.h"
 #include "render/pixel_filter.h"
 #include "render/wavefront.h"
@@ -9,36 +12,53 @@
 namespace fh {
 namespace {
 
-constexpr const char* kKernel = "light_trace";
-// Per pixel: three 64-bit sums as (low, high) words (kernels/light_trace.cl, FH_SPLAT_WORDS).
+// Per pixel: three 64-bit sums as (low, high) words (kernels/light_paths.h, FH_SPLAT_WORDS).
 constexpr size_t kSplatWords = 6;
+// bdpt: a light vertex's bytes (kernels/bdpt.cl, FH_BDPT_VERTEX_WORDS float4s), and the most
+// a launch's light vertices may take.
+constexpr size_t kVertexBytes = 3 * 16;
+constexpr size_t kVertexBufferBytes = size_t(32) << 20;
 
 }  // namespace
 
-ProgramSpec lightTracerProgram(const SceneFeatures& features, const std::string& traversalOptions) {
-  return {"light tracer (" + std::string(methodName(Method::LT)) + features.buildOptions() + ")", {"light_trace.cl"},
-          traversalOptions + features.buildOptions() + " -DFH_LANES=1"};
+ProgramSpec lightTracerProgram(Method method, const SceneFeatures& features, const std::string& traversalOptions) {
+  const bool bdpt = method == Method::BDPT;
+  const int only = testHooks().bdptOnlyLightVertices;
+  const std::string strategy = bdpt && only >= 0 ? " -DFH_BDPT_ONLY_S=" + std::to_string(only) + "u" : "";
+  return {std::string(bdpt ? "bidirectional path tracer (" : "light tracer (") + methodName(method) +
+              features.buildOptions() + strategy + ")",
+          {bdpt ? "bdpt.cl" : "light_trace.cl"}, traversalOptions + features.buildOptions() + strategy + " -DFH_LANES=1"};
 }
 
 LightTracer::LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bvh& bvh, const Camera& camera,
                          const RenderSettings& s)
     : dc_(dc),
-      // Delta lobes: glass, and mirrors (compiled with the glossy lobes).
-      cameraPaths_(scene.features.glass || scene.features.glossy
+      // lt: delta lobes (glass, and mirrors, compiled with the glossy lobes) seen directly.
+      cameraPaths_(s.method == Method::LT && (scene.features.glass || scene.features.glossy)
                        ? std::make_unique<WavefrontPipeline>(dc, scene, bvh, camera, s)
                        : nullptr),
       ownScene_(cameraPaths_ ? nullptr : std::make_unique<DeviceScene>(dc, scene, bvh)),
       scene_(cameraPaths_ ? cameraPaths_->deviceScene() : *ownScene_),
-      pixels_(unsigned(s.width) * unsigned(s.height)) {
+      pixels_(unsigned(s.width) * unsigned(s.height)),
+      method_(s.method),
+      kernelName_(s.method == Method::BDPT ? "bdpt" : "light_trace") {
   std::vector<float> inverseCdf;
   params_ = renderParams(s, camera, scene_, inverseCdf);
   // The splats weigh by the filter's density where camera rays are offset by its inverse CDF.
   const std::vector<float> density = filterDensity(s.filter, int(params_.filter_table_size));
   density_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, density.size() * 4, "filter density",
                             density.data());
-  const cl::Program program =
-      buildProgram(dc.context, dc.info.device, lightTracerProgram(scene_.features, scene_.bvh.traversalOptions()));
-  kernel_ = createKernel(program, kKernel);
+  const cl::Program program = buildProgram(dc.context, dc.info.device,
+                                           lightTracerProgram(method_, scene_.features, scene_.bvh.traversalOptions()));
+  kernel_ = createKernel(program, kernelName_);
+  if (method_ == Method::BDPT) {
+    filterTable_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, inverseCdf.size() * 4,
+                                  "filter inverse CDF", inverseCdf.data());
+    const size_t perPath = size_t(std::max(s.maxDepth, 1)) * kVertexBytes;
+    pathsPerLaunch_ = unsigned(std::min<size_t>(pixels_, std::max<size_t>(kVertexBufferBytes / perPath, 64)));
+    lightVertices_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, pathsPerLaunch_ * perPath,
+                                    "bidirectional light vertices");
+  }
   for (Slot& slot : slots_) {
     slot.splats = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, size_t(pixels_) * kSplatWords * 4,
                                  "light tracing splats");
@@ -74,10 +94,21 @@ void LightTracer::enqueueIteration() {
   static const uint32_t zero = 0;
   FH_CL(dc_.queue.enqueueFillBuffer(slot.splats, zero, 0, size_t(pixels_) * kSplatWords * 4));
   FH_CL(dc_.queue.enqueueFillBuffer(slot.tallies, zero, 0, 16));
-  bindAll(kernel_, kKernel, params_, slot.global, slot.splats, density_, slot.tallies, scene_.buffers);
-  cl::Event event;
-  launch(dc_, kernel_, pixels_, kKernel, &event);
-  events_.push_back(event);
+  if (method_ == Method::BDPT) {
+    for (unsigned first = 0; first < pixels_; first += pathsPerLaunch_) {
+      const unsigned count = std::min(pathsPerLaunch_, pixels_ - first);
+      bindAll(kernel_, kernelName_, params_, slot.global, first, count, lightVertices_, filterTable_, slot.splats,
+              density_, slot.tallies, scene_.buffers);
+      cl::Event event;
+      launch(dc_, kernel_, count, kernelName_, &event);
+      events_.push_back(event);
+    }
+  } else {
+    bindAll(kernel_, kernelName_, params_, slot.global, slot.splats, density_, slot.tallies, scene_.buffers);
+    cl::Event event;
+    launch(dc_, kernel_, pixels_, kernelName_, &event);
+    events_.push_back(event);
+  }
   FH_CL(dc_.queue.enqueueReadBuffer(slot.splats, CL_FALSE, 0, slot.splatWords.size() * 4, slot.splatWords.data()));
   FH_CL(dc_.queue.enqueueReadBuffer(slot.tallies, CL_FALSE, 0, 12, slot.tallyWords.data()));
   slot.state = State::Launched;
@@ -91,6 +122,7 @@ void LightTracer::readCounters() {
     slot.state = State::Read;
     stats_.bounceRays += slot.tallyWords[0];
     stats_.shadowRays += slot.tallyWords[1];
+    if (method_ == Method::BDPT) stats_.cameraRays += pixels_;
     stats_.nonfinite += slot.tallyWords[2];
     stats_.iterations += 1;
   }
@@ -98,7 +130,7 @@ void LightTracer::readCounters() {
     cl_ulong start = 0, end = 0;
     FH_CL(event.getProfilingInfo(CL_PROFILING_COMMAND_START, &start));
     FH_CL(event.getProfilingInfo(CL_PROFILING_COMMAND_END, &end));
-    stats_.stageSeconds[kKernel] += double(end - start) * 1e-9;
+    stats_.stageSeconds[kernelName_] += double(end - start) * 1e-9;
   }
   events_.clear();
 }

@@ -1,14 +1,17 @@
-// Light tracing on one device (--method lt, kernels/light_trace.cl): a pass is one light
-// path per pixel of the image, each connected to the camera at every vertex that can be,
-// its contributions splatted to the pixels they land on as whole film quanta in 64-bit
-// integers. A pass's sums are then the same bits whichever order its paths added them
-// in, so films merge exactly as the path tracer's do. A pass runs as one launch into a
-// splat buffer of its own, read back whole.
+// Light tracing (--method lt, kernels/light_trace.cl) and bidirectional path tracing
+// (--method bdpt, kernels/bdpt.cl) on one device: a pass is one light path per pixel of the
+// image (and for bdpt one camera path per pixel too), each connected to the camera at every
+// vertex that can be, its contributions splatted to the pixels they land on as whole film
+// quanta in 64-bit integers. A pass's sums are then the same bits whichever order its paths
+// added them in, so films merge exactly as the path tracer's do. A pass runs as launches
+// into a splat buffer of its own (bdpt: as many paths a launch as its light vertices' buffer
+// holds), read back whole.
 //
 // Light paths cannot reach the camera through a delta lobe (a mirror or glass seen
-// directly): in a scene that has them, a camera pass (the path tracer's mis, keeping only
-// the paths that leave their first vertex by a delta lobe: FH_LIGHT_TRACED_FIRST_VERTEX)
-// renders the same pass beside it, and a pass's sample is the sum of the two.
+// directly): for lt, in a scene that has them, a camera pass (the path tracer's mis, keeping
+// only the paths that leave their first vertex by a delta lobe: FH_LIGHT_TRACED_FIRST_VERTEX)
+// renders the same pass beside it, and a pass's sample is the sum of the two. bdpt's camera
+// subpaths find those paths themselves.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -22,8 +25,9 @@
 
 namespace fh {
 
-// The light tracer's program for a scene's features: one lane, one light path per work-item.
-ProgramSpec lightTracerProgram(const SceneFeatures& features, const std::string& traversalOptions);
+// The light tracer's (method lt) or bidirectional path tracer's (bdpt) program for a scene's
+// features: one lane, one light path (and for bdpt one camera path) per work-item.
+ProgramSpec lightTracerProgram(Method method, const SceneFeatures& features, const std::string& traversalOptions);
 
 class LightTracer : public PassRenderer {
  public:
@@ -64,8 +68,13 @@ class LightTracer : public PassRenderer {
   const DeviceScene& scene_;
   gpu::RenderParams params_{};
   unsigned pixels_;
+  Method method_;
+  const char* kernelName_;
   cl::Kernel kernel_;
   cl::Buffer density_;
+  // bdpt: the filter's inverse CDF (camera paths) and the light vertices of one launch's paths.
+  cl::Buffer filterTable_, lightVertices_;
+  unsigned pathsPerLaunch_ = 0;
   std::array<Slot, kSlots> slots_;
   uint64_t nextLaunch_ = 0, granted_ = 0;  // local passes
   RenderStats stats_;

@@ -116,7 +116,7 @@ class Render {
 
   // The method's pipeline on one device: paths from the camera, or from the lights.
   std::unique_ptr<PassRenderer> passRenderer(DeviceContext& dc, const RenderSettings& s) const {
-    if (s.method == Method::LT) return std::make_unique<LightTracer>(dc, scene_, bvh_, camera_, s);
+    if (tracesLightPaths(s.method)) return std::make_unique<LightTracer>(dc, scene_, bvh_, camera_, s);
     return std::make_unique<WavefrontPipeline>(dc, scene_, bvh_, camera_, s);
   }
 

@@ -11,6 +11,7 @@ const char* methodName(Method m) {
     case Method::NEE: return "nee";
     case Method::MIS: return "mis";
     case Method::LT: return "lt";
+    case Method::BDPT: return "bdpt";
   }
   return "?";
 }

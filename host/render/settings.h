@@ -17,9 +17,12 @@ class FilmWatcher;
 class PassLedger;
 
 // pt, nee and mis trace paths from the camera (render/wavefront.h); lt traces them from the
-// lights and connects each vertex to the camera (render/light_tracer.h).
-enum class Method { PT, NEE, MIS, LT };
+// lights and connects each vertex to the camera, and bdpt traces both and joins them
+// (render/light_tracer.h).
+enum class Method { PT, NEE, MIS, LT, BDPT };
 const char* methodName(Method m);
+// lt and bdpt: paths from the emitting triangles, splatted where the camera sees them.
+inline bool tracesLightPaths(Method m) { return m == Method::LT || m == Method::BDPT; }
 
 enum class PixelFilter { Box, Gaussian, BlackmanHarris };
 const char* filterName(PixelFilter f);

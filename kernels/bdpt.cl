@@ -1,0 +1,341 @@
+// Bidirectional path tracing (--method bdpt; Veach 1997 ch. 10, Veach and Guibas 1995): each
+// work-item traces a light subpath from the emitters and a camera subpath through its pixel,
+// and joins them in every way a path of at most max_depth scattering vertices can be made:
+//   s = 0   the camera subpath hits an emitter,
+//   s = 1   a camera vertex connected to a point on an emitter (the light table, uniform in area),
+//   s >= 2  a camera vertex connected to each stored light vertex,
+//   t = 1   each light vertex connected to the pinhole, splatted where the camera sees it
+//           (light tracing, kernels/light_paths.h).
+// Every contribution is weighted by the power heuristic over all the strategies that could
+// have made its path. The weights are computed recursively along the subpaths (Georgiev,
+// "Implementing vertex connection and merging", 2012: the quantities d_vcm and d_vc, here
+// without merging): each vertex carries two partial sums of squared density ratios, so a
+// connection needs only its two end vertices. Densities in the weights are those of the
+// unbiased strategies without Russian roulette (the weights still sum to one over the
+// strategies, which is all that unbiasedness asks of them), with area conversions by the
+// geometric normal. The directly seen emitter is the camera's alone (no s = 1, t = 1).
+//
+// A pass is one light and one camera subpath per pixel. The camera subpath's sum goes to
+// its own pixel (the filter is importance-sampled, as in the path tracer); light tracing's
+// splats land anywhere. Both are added as whole film quanta (light_paths.h), so a pass is
+// the same bits on any device count, chunking and rank count. The camera's density of a
+// direction in the weights is the whole film's, 1 / (A cos^3): N = W H light paths per pass
+// against one camera path per pixel.
+//
+// Light vertices wait in `stored`, FH_BDPT_VERTEX_WORDS float4s each, max_depth per path: a
+// launch covers `count` paths from `first`, as many as the buffer holds.
+#include "camera.h"
+#include "film.h"
+#include "light_paths.h"
+
+// A stored light vertex: (triangle bits, b1, b2, d_vcm), (w_in, d_vc), (alpha, scatterings).
+#define FH_BDPT_VERTEX_WORDS 3
+
+// The power heuristic's weight of a density ratio.
+FH_INLINE float mis2(float x) { return x * x; }
+
+// The weight a contribution of strategy s (its light vertices) to a path of m scattering
+// vertices counts with: the power heuristic's, or under FH_BDPT_ONLY_S (a test hook,
+// base/test_hooks.h) one for the one strategy kept for paths of that length (s = ONLY_S, or
+// the nearest below it that such a path has; the camera's alone for a directly seen emitter)
+// and none for the others, so that each strategy can be tested alone.
+FH_INLINE float strategy_weight(float power_heuristic, uint s, uint m) {
+#if defined(FH_BDPT_ONLY_S)
+  const uint kept = m == 0u ? 0u : min(FH_BDPT_ONLY_S, m + 1u);
+  return s == kept ? 1.0f : 0.0f;
+#else
+  return power_heuristic;
+#endif
+}
+
+// The recursive weights' state after a hit at distance d under |cos| = cos_g (the geometric
+// normal and the arriving direction): the densities of the new vertex in area measure.
+FH_INLINE void weights_at_hit(float* d_vcm, float* d_vc, float d, float cos_g) {
+  *d_vcm *= mis2(d * d) / mis2(cos_g);
+  *d_vc /= mis2(cos_g);
+}
+
+// ... and after a BSDF sample from there (pdf < 0: a delta lobe, whose choice is as likely
+// both ways and whose vertex no connection can use): cos_out at the vertex toward the new
+// direction, pdf_rev the density of sampling the way back.
+FH_INLINE void weights_at_sample(float* d_vcm, float* d_vc, float pdf, float pdf_rev, float cos_out) {
+  if (pdf < 0.0f) {
+    *d_vcm = 0.0f;
+    *d_vc *= mis2(cos_out);
+  } else {
+    *d_vc = mis2(cos_out / pdf) * (*d_vc * mis2(pdf_rev) + *d_vcm);
+    *d_vcm = mis2(1.0f / pdf);
+  }
+}
+
+// The light subpath's reach: its surface vertices (as light_trace.cl reaches them) stored
+// where a smooth lobe can connect them, each connected to the camera. Returns how many are
+// stored.
+FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, uint stream, uint path,
+                                   __global float4* stored, volatile __global uint* splats,
+                                   __global const float* density, LightTally* tally) {
+  uint dim = 0u, count = 0u;
+  const float u_pick = random_float(stream, path, dim++);
+  const int light = scene->light_triangle[pick_light(scene->light_cdf, params.light_count, u_pick)];
+  const float u1 = random_float(stream, path, dim++), u2 = random_float(stream, path, dim++);
+  const lvec2 b = sample_triangle(u1, u2);
+  const SurfacePoint y = surface_point(scene->triangles, light, b.x, b.y);
+  const float pdf_area = scene->light_pdf_area[light];
+  const lvec3 le = material_lanes(scene->materials, scene->triangle_material[light]).ke;
+  const float u3 = random_float(stream, path, dim++), u4 = random_float(stream, path, dim++);
+  lvec3 dir = sample_cosine_hemisphere(y.normal, u3, u4);
+  const float cos_light = v3_dot(y.normal, dir);
+  if (!(cos_light > 0.0f) || !(pdf_area > 0.0f)) return 0u;
+  // Le cos / (p_A cos / pi); the emission density p_A cos / pi against light sampling's p_A
+  // (d_vcm) and against the camera hitting the light (d_vc).
+  lvec3 alpha = v3_scale(le, M_PI_F / pdf_area);
+  float d_vcm = mis2(M_PI_F / cos_light), d_vc = mis2(M_PI_F / pdf_area);
+  lvec3 org = offset_ray_origin(&y, dir);
+  lvec3 carried = v3_splat(1.0f);
+
+  for (uint scatterings = 1u; scatterings <= params.max_depth; ++scatterings) {
+    ++tally->bounce_rays;
+    const TraceHit hit = trace_ray(scene->nodes, scene->blocks, (float3)(org.x, org.y, org.z),
+                                   (float3)(dir.x, dir.y, dir.z), 0.0f, INFINITY);
+    if (hit.triangle < 0) break;
+    const LightVertex v = light_vertex(scene, hit);
+    const lvec3 w_in = v3_neg(dir);
+    const float cos_g_in = v3_dot(v.point.normal, w_in);
+    if (cos_g_in == 0.0f) break;
+    weights_at_hit(&d_vcm, &d_vc, hit.t, fabs(cos_g_in));
+    const lvec3 g = cos_g_in > 0.0f ? v.point.normal : v3_neg(v.point.normal);
+    const lvec3 n = cos_g_in > 0.0f ? v.shading_normal : v3_neg(v.shading_normal);
+
+    if (bsdf_has_smooth_lobe(&v.bsdf)) {
+      __global float4* s = stored + FH_BDPT_VERTEX_WORDS * count++;
+      s[0] = (float4)(as_float(hit.triangle), hit.b1, hit.b2, d_vcm);
+      s[1] = (float4)(w_in.x, w_in.y, w_in.z, d_vc);
+      s[2] = (float4)(alpha.x, alpha.y, alpha.z, (float)scatterings);
+      // t = 1: the pinhole, weighed against the camera finding this vertex (the film's
+      // density of it, in area) and everything further from the camera.
+      const CameraView view = camera_view(params, &v.point);
+      const float cos_camera = v3_dot(g, view.to_camera);
+      if (view.seen && cos_camera > 0.0f) {
+        const lvec3 f = bsdf_eval(&v.bsdf, n, view.to_camera, w_in);
+        const float pdf_rev = bsdf_pdf(&v.bsdf, n, view.to_camera, w_in);
+        const float w_light = mis2(view.importance * cos_camera) * (d_vcm + d_vc * mis2(pdf_rev));
+        const float weight = strategy_weight(1.0f / (1.0f + w_light), scatterings + 1u, scatterings);
+        connect_to_camera(params, scene, &view,
+                          v3_scale(v3_mul(alpha, f), fabs(v3_dot(n, w_in)) * cos_camera / fabs(cos_g_in) * weight),
+                          splats, density, tally);
+      }
+    }
+    if (scatterings == params.max_depth) break;
+
+    const float u0 = random_float(stream, path, dim++);
+    const float u5 = random_float(stream, path, dim++), u6 = random_float(stream, path, dim++);
+    const BsdfSample s = bsdf_sample(&v.bsdf, v.point.normal, v.shading_normal, w_in, u0, u5, u6);
+    if (s.pdf == 0.0f) break;
+    const float pdf_rev = s.pdf > 0.0f ? bsdf_pdf(&v.bsdf, n, s.wi, w_in) : 0.0f;
+    weights_at_sample(&d_vcm, &d_vc, s.pdf, pdf_rev, fabs(v3_dot(v.point.normal, s.wi)));
+    const lvec3 weight = adjoint_weight(&v, n, w_in, &s);
+    alpha = v3_mul(alpha, weight);
+    carried = v3_mul(carried, weight);
+    if (scatterings >= params.rr_depth) {
+      const float survive = fmin(v3_max_component(carried), 0.95f);
+      if (random_float(stream, path, dim++) >= survive) break;
+      alpha = v3_scale(alpha, 1.0f / survive);
+      carried = v3_scale(carried, 1.0f / survive);
+    }
+    if (!v3_any_positive(alpha)) break;
+    dir = s.wi;
+    org = offset_ray_origin(&v.point, s.wi);
+  }
+  return count;
+}
+
+// A camera vertex as the connections see it: its surface, the normals on the viewer's side
+// (g geometric, n shading), the direction back toward the camera, the throughput and the
+// recursive weights' state.
+typedef struct {
+  LightVertex v;
+  lvec3 g, n, wo, beta;
+  float d_vcm, d_vc;
+  uint scatterings;  // this vertex's count from the camera, 1 for the first hit
+} CameraVertex;
+
+// Whether the segment from a to b (both points just off their surfaces) is clear.
+FH_INLINE int unoccluded(const SceneView* scene, lvec3 a, lvec3 b, LightTally* tally) {
+  const lvec3 d = v3_sub(b, a);
+  const float distance = v3_length(d);
+  if (!(distance > 0.0f)) return 0;
+  const lvec3 w = v3_scale(d, 1.0f / distance);
+  ++tally->camera_rays;
+  return find_occluder(scene->nodes, scene->blocks, (float3)(a.x, a.y, a.z), (float3)(w.x, w.y, w.z), 0.0f,
+                       distance * FH_SHADOW_SHORTEN) < 0;
+}
+
+// s = 1: a point uniform in the area of a light triangle picked by the light table.
+FH_INLINE lvec3 connect_to_light(RenderParams params, const SceneView* scene, const CameraVertex* c, float u_pick,
+                                 float u1, float u2, LightTally* tally) {
+  const int light = scene->light_triangle[pick_light(scene->light_cdf, params.light_count, u_pick)];
+  const lvec2 b = sample_triangle(u1, u2);
+  const SurfacePoint y = surface_point(scene->triangles, light, b.x, b.y);
+  const float pdf_area = scene->light_pdf_area[light];
+  const lvec3 to_light = v3_sub(y.position, c->v.point.position);
+  const float d2 = v3_dot(to_light, to_light);
+  const lvec3 wi = v3_scale(to_light, rsqrt(d2));
+  const float cos_light = -v3_dot(y.normal, wi), cos_s = v3_dot(c->n, wi), cos_g = v3_dot(c->g, wi);
+  if (!(cos_light > 0.0f && cos_s > 0.0f && cos_g > 0.0f && pdf_area > 0.0f && d2 > 0.0f)) return v3_splat(0.0f);
+  const lvec3 f = bsdf_eval(&c->v.bsdf, c->n, c->wo, wi);
+  const lvec3 le = material_lanes(scene->materials, scene->triangle_material[light]).ke;
+  const float pdf_w = pdf_area * d2 / cos_light;
+  // Against BSDF sampling finding the light, and against the light subpaths that leave
+  // the light through this vertex (emission density cos_light / pi, times p_A, over p_A).
+  const float w_light = mis2(bsdf_pdf(&c->v.bsdf, c->n, c->wo, wi) / pdf_w);
+  const float w_camera = mis2(cos_light * cos_g / (M_PI_F * d2)) *
+                         (c->d_vcm + c->d_vc * mis2(bsdf_pdf(&c->v.bsdf, c->n, wi, c->wo)));
+  const float weight = strategy_weight(1.0f / (w_light + 1.0f + w_camera), 1u, c->scatterings);
+  const lvec3 value = v3_scale(v3_mul(v3_mul(c->beta, f), le), cos_s * weight / pdf_w);
+  if (!v3_any_positive(value)) return v3_splat(0.0f);
+  const lvec3 from = offset_ray_origin(&c->v.point, c->g), to = offset_ray_origin(&y, v3_neg(wi));
+  return unoccluded(scene, from, to, tally) ? value : v3_splat(0.0f);
+}
+
+// s >= 2: the camera vertex joined to a stored light vertex.
+FH_INLINE lvec3 connect_vertices(const SceneView* scene, const CameraVertex* c, __global const float4* s,
+                                 LightTally* tally) {
+  const float4 s0 = s[0], s1 = s[1], s2 = s[2];
+  TraceHit hit;
+  hit.triangle = as_int(s0.x);
+  hit.b1 = s0.y;
+  hit.b2 = s0.z;
+  hit.t = 0.0f;
+  const LightVertex l = light_vertex(scene, hit);
+  const lvec3 w_in = v3(s1.x, s1.y, s1.z), alpha = v3(s2.x, s2.y, s2.z);
+  const float cos_l_in = v3_dot(l.point.normal, w_in);
+  const lvec3 g_l = cos_l_in > 0.0f ? l.point.normal : v3_neg(l.point.normal);
+  const lvec3 n_l = cos_l_in > 0.0f ? l.shading_normal : v3_neg(l.shading_normal);
+  const lvec3 d = v3_sub(l.point.position, c->v.point.position);
+  const float d2 = v3_dot(d, d);
+  if (!(d2 > 0.0f)) return v3_splat(0.0f);
+  const lvec3 w = v3_scale(d, rsqrt(d2)), back = v3_neg(w);  // camera to light vertex, and back
+  const float cos_c = v3_dot(c->n, w), cos_c_g = v3_dot(c->g, w), cos_l_g = v3_dot(g_l, back);
+  if (!(cos_c > 0.0f && cos_c_g > 0.0f && cos_l_g > 0.0f)) return v3_splat(0.0f);
+  const lvec3 f_c = bsdf_eval(&c->v.bsdf, c->n, c->wo, w), f_l = bsdf_eval(&l.bsdf, n_l, back, w_in);
+  // The camera side's radiance weights, the light side's as light_trace.cl weighs a bounce
+  // toward the camera, and 1/d^2 between them.
+  const lvec3 value = v3_scale(v3_mul(v3_mul(c->beta, f_c), v3_mul(f_l, alpha)),
+                               cos_c * fabs(v3_dot(n_l, w_in)) * cos_l_g / (fabs(cos_l_in) * d2));
+  if (!v3_any_positive(value)) return v3_splat(0.0f);
+  // Against the strategies with one more light vertex (the camera side's BSDF sampling
+  // reaching the light vertex) and one more camera vertex, and all those beyond them.
+  const float pdf_camera_a = bsdf_pdf(&c->v.bsdf, c->n, c->wo, w) * cos_l_g / d2;
+  const float pdf_light_a = bsdf_pdf(&l.bsdf, n_l, w_in, back) * cos_c_g / d2;
+  const float w_light = mis2(pdf_camera_a) * (s0.w + s1.w * mis2(bsdf_pdf(&l.bsdf, n_l, back, w_in)));
+  const float w_camera = mis2(pdf_light_a) * (c->d_vcm + c->d_vc * mis2(bsdf_pdf(&c->v.bsdf, c->n, w, c->wo)));
+  const uint light_scatterings = (uint)s2.w;
+  const float weight =
+      strategy_weight(1.0f / (w_light + 1.0f + w_camera), light_scatterings + 1u, light_scatterings + c->scatterings);
+  if (!(weight > 0.0f)) return v3_splat(0.0f);
+  const lvec3 from = offset_ray_origin(&c->v.point, c->g), to = offset_ray_origin(&l.point, g_l);
+  return unoccluded(scene, from, to, tally) ? v3_scale(value, weight) : v3_splat(0.0f);
+}
+
+__kernel void bdpt(RenderParams params, uint pass, uint first, uint count, __global float4* stored,
+                   __global const float* filter_table, __global uint* splats, __global const float* density,
+                   __global uint* tallies FH_SCENE_PARAMS) {
+  const uint index = get_global_id(0);
+  if (index >= count || params.light_count == 0u) return;
+  const uint path = first + index;
+  if (path >= params.pixel_count) return;
+  const SceneView scene = FH_SCENE_VIEW;
+  const uint stream = hash_combine(params.seed, pass);
+  LightTally tally = {0u, 0u, 0u};
+  __global float4* own = stored + (size_t)index * params.max_depth * FH_BDPT_VERTEX_WORDS;
+  const uint light_vertices =
+      trace_light_subpath(params, &scene, hash_combine(stream, 1u), path, own, splats, density, &tally);
+
+  // The camera subpath through pixel `path`, its position offset by the filter.
+  const uint camera_stream = hash_combine(stream, 2u);
+  uint dim = 0u;
+  const CameraParams* cam = &params.camera;
+  const uint width = (uint)cam->width;
+  const float px = (float)(path % width) + 0.5f +
+                   filter_offset(filter_table, params.filter_table_size, random_float(camera_stream, path, dim++));
+  const float py = (float)(path / width) + 0.5f +
+                   filter_offset(filter_table, params.filter_table_size, random_float(camera_stream, path, dim++));
+  lvec3 dir = camera_ray_direction(cam, px, py);
+  lvec3 org = v3_uniform(vload3(0, cam->origin));
+  const float cos_camera = v3_dot(dir, v3_uniform(vload3(0, cam->forward)));
+  const float film_area = 4.0f * v3_length(v3_uniform(vload3(0, cam->right))) * v3_length(v3_uniform(vload3(0, cam->up)));
+  CameraVertex c;
+  c.beta = v3_splat(1.0f);
+  c.d_vcm = mis2(film_area * cos_camera * cos_camera * cos_camera);  // 1 / the film's density of dir
+  c.d_vc = 0.0f;
+  lvec3 sum = v3_splat(0.0f);
+
+  for (c.scatterings = 1u; c.scatterings <= params.max_depth + 1u; ++c.scatterings) {
+    if (c.scatterings > 1u) ++tally.bounce_rays;  // the camera ray: the host counts one a pixel
+    const TraceHit hit = trace_ray(scene.nodes, scene.blocks, (float3)(org.x, org.y, org.z),
+                                   (float3)(dir.x, dir.y, dir.z), 0.0f, INFINITY);
+    if (hit.triangle < 0) break;
+    c.v = light_vertex(&scene, hit);
+    c.wo = v3_neg(dir);
+    const float cos_g = v3_dot(c.v.point.normal, c.wo);
+    if (cos_g == 0.0f) break;
+    weights_at_hit(&c.d_vcm, &c.d_vc, hit.t, fabs(cos_g));
+    c.g = cos_g > 0.0f ? c.v.point.normal : v3_neg(c.v.point.normal);
+    c.n = cos_g > 0.0f ? c.v.shading_normal : v3_neg(c.v.shading_normal);
+
+    // s = 0: emission from the front, weighed against light sampling (p_A) and the light
+    // subpaths leaving from this point (p_A cos / pi); seen directly, the camera's alone.
+    if (cos_g > 0.0f) {
+      const lvec3 ke = material_lanes(scene.materials, scene.triangle_material[hit.triangle]).ke;
+      if (v3_any_positive(ke)) {
+        const float pdf_area = scene.light_pdf_area[hit.triangle];
+        const float w_camera = c.scatterings == 1u ? 0.0f
+                                                   : mis2(pdf_area) * c.d_vcm +
+                                                         mis2(pdf_area * cos_g * M_1_PI_F) * c.d_vc;
+        sum = v3_add(sum, v3_scale(v3_mul(c.beta, ke), strategy_weight(1.0f / (1.0f + w_camera), 0u, c.scatterings - 1u)));
+      }
+    }
+    if (c.scatterings > params.max_depth) break;
+
+    if (bsdf_has_smooth_lobe(&c.v.bsdf)) {
+      const float u_pick = random_float(camera_stream, path, dim++);
+      const float u1 = random_float(camera_stream, path, dim++), u2 = random_float(camera_stream, path, dim++);
+      sum = v3_add(sum, connect_to_light(params, &scene, &c, u_pick, u1, u2, &tally));
+      for (uint k = 0u; k < light_vertices; ++k) {
+        __global const float4* s = own + FH_BDPT_VERTEX_WORDS * k;
+        if (c.scatterings + (uint)s[2].w > params.max_depth) break;  // stored in order of scatterings
+        sum = v3_add(sum, connect_vertices(&scene, &c, s, &tally));
+      }
+    } else {
+      dim += 3u;
+    }
+
+    const float u0 = random_float(camera_stream, path, dim++);
+    const float u5 = random_float(camera_stream, path, dim++), u6 = random_float(camera_stream, path, dim++);
+    const BsdfSample b = bsdf_sample(&c.v.bsdf, c.v.point.normal, c.v.shading_normal, c.wo, u0, u5, u6);
+    if (b.pdf == 0.0f) break;
+    const float pdf_rev = b.pdf > 0.0f ? bsdf_pdf(&c.v.bsdf, c.n, b.wi, c.wo) : 0.0f;
+    weights_at_sample(&c.d_vcm, &c.d_vc, b.pdf, pdf_rev, fabs(v3_dot(c.v.point.normal, b.wi)));
+    c.beta = v3_mul(c.beta, b.weight);
+    if (c.scatterings >= params.rr_depth) {
+      const float survive = fmin(v3_max_component(c.beta), 0.95f);
+      if (random_float(camera_stream, path, dim++) >= survive) break;
+      c.beta = v3_scale(c.beta, 1.0f / survive);
+    }
+    if (!v3_any_positive(c.beta)) break;
+    dir = b.wi;
+    org = offset_ray_origin(&c.v.point, b.wi);
+  }
+
+  if (isfinite(sum.x) && isfinite(sum.y) && isfinite(sum.z)) {
+    volatile __global uint* own_pixel = splats + FH_SPLAT_WORDS * path;
+    add_quanta(own_pixel, sum.x);
+    add_quanta(own_pixel + 2, sum.y);
+    add_quanta(own_pixel + 4, sum.z);
+  } else {
+    ++tally.nonfinite;
+  }
+  atomic_add(tallies, tally.bounce_rays);
+  atomic_add(tallies + 1, tally.camera_rays);
+  if (tally.nonfinite) atomic_add(tallies + 2, tally.nonfinite);
+}

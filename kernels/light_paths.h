@@ -1,0 +1,170 @@
+// What light paths share (light tracing, kernels/light_trace.cl; bidirectional path tracing,
+// kernels/bdpt.cl): contributions added as whole film quanta with integer atomics (splats),
+// the pinhole as a point sees it, the surfaces light paths reach and the adjoint weight of
+// their BSDF samples. One lane.
+#ifndef FH_LIGHT_PATHS_H
+#define FH_LIGHT_PATHS_H
+
+#include "bsdf.h"
+#include "intersect.h"
+#include "lights.h"
+#include "ray.h"
+#include "rng.h"
+#include "sampling.h"
+#include "scene_view.h"
+#include "surface.h"
+
+// A splat's resolution, the film's quantum (host/render/film.h), and its cap: 2^24 quanta
+// of radiance in one splat keep 65536 of them per pixel below 2^64.
+#define FH_SPLAT_QUANTA 16777216.0f
+#define FH_SPLAT_MOST 16777216.0f
+
+// Per pass: the pass's splats, three 64-bit sums (low, high words) per pixel.
+#define FH_SPLAT_WORDS 6
+
+// Adds v >= 0, as whole quanta, to the 64-bit integer at sum (low word first): the carry
+// out of the low word goes into the high word, so the total is exact in any order.
+FH_INLINE void add_quanta(volatile __global uint* sum, float v) {
+  const ulong q = convert_ulong_sat_rte(fmin(v, FH_SPLAT_MOST) * FH_SPLAT_QUANTA);
+  const uint low = (uint)q, high = (uint)(q >> 32);
+  if (low != 0u) {
+    const uint before = atomic_add(sum, low);
+    if (before + low < before) atomic_inc(sum + 1);
+  }
+  if (high != 0u) atomic_add(sum + 1, high);
+}
+
+// Pixel filter g(d) over one axis (a density: it integrates to one), tabulated over
+// [-radius, radius] by the host (render/pixel_filter.h).
+FH_INLINE float filter_density(__global const float* table, uint size, float radius, float d) {
+  const float x = (d + radius) / (2.0f * radius) * (float)(size - 1);
+  if (!(x >= 0.0f && x <= (float)(size - 1))) return 0.0f;
+  const uint i = min((uint)x, size - 2);
+  return mix(table[i], table[i + 1], x - (float)i);
+}
+
+// Adds the radiance c seen at image position p (pixels) to every pixel whose filter covers p,
+// weighted by its filter there. The box filter covers one pixel, the one p lies in.
+FH_INLINE void splat(RenderParams params, volatile __global uint* splats, __global const float* density, float2 p,
+                     lvec3 c) {
+  const int w = params.camera.width, h = params.camera.height;
+  const float r = params.filter_radius;
+  const bool box = r <= 0.5f;  // weight one in the pixel p lies in, none elsewhere
+  const int x0 = box ? (int)floor(p.x) : (int)ceil(p.x - 0.5f - r), x1 = box ? x0 : (int)floor(p.x - 0.5f + r);
+  const int y0 = box ? (int)floor(p.y) : (int)ceil(p.y - 0.5f - r), y1 = box ? y0 : (int)floor(p.y - 0.5f + r);
+  for (int y = max(y0, 0); y <= min(y1, h - 1); ++y) {
+    const float gy = box ? 1.0f : filter_density(density, params.filter_table_size, r, p.y - ((float)y + 0.5f));
+    for (int x = max(x0, 0); x <= min(x1, w - 1); ++x) {
+      const float g = gy * (box ? 1.0f : filter_density(density, params.filter_table_size, r, p.x - ((float)x + 0.5f)));
+      if (g <= 0.0f) continue;
+      volatile __global uint* sum = splats + FH_SPLAT_WORDS * ((uint)y * (uint)w + (uint)x);
+      add_quanta(sum, c.x * g);
+      add_quanta(sum + 2, c.y * g);
+      add_quanta(sum + 4, c.z * g);
+    }
+  }
+}
+
+// A point as the pinhole sees it: the unit direction to the camera, from the ray origin
+// just off the surface on the camera's side; the image position (pixels, (0, 0) at the
+// top-left corner, as camera_ray_direction takes it) and the importance per pixel filter,
+// 1 / (A d^2 cos^3 theta). `seen`: in front of the camera and within a filter's reach of
+// the image.
+typedef struct {
+  lvec3 origin, to_camera;
+  float distance, importance;
+  float2 image;
+  int seen;
+} CameraView;
+
+FH_INLINE CameraView camera_view(RenderParams params, const SurfacePoint* at) {
+  const CameraParams* cam = &params.camera;
+  const lvec3 eye = v3_uniform(vload3(0, cam->origin)), f = v3_uniform(vload3(0, cam->forward)),
+              right = v3_uniform(vload3(0, cam->right)), up = v3_uniform(vload3(0, cam->up));
+  CameraView v;
+  v.origin = offset_ray_origin(at, v3_sub(eye, at->position));
+  const lvec3 d = v3_sub(eye, v.origin);
+  v.distance = v3_length(d);
+  v.to_camera = v3_scale(d, 1.0f / v.distance);
+  // Toward the point from the camera, on the image plane one unit ahead.
+  const float cos_theta = -v3_dot(v.to_camera, f);
+  const lvec3 q = v3_scale(v.to_camera, -1.0f / cos_theta);
+  const float sx = v3_dot(q, right) / v3_dot(right, right), sy = v3_dot(q, up) / v3_dot(up, up);
+  v.image = (float2)(0.5f * (sx + 1.0f) * (float)cam->width, 0.5f * (1.0f - sy) * (float)cam->height);
+  const float reach = fmax(params.filter_radius - 0.5f, 0.0f);
+  v.seen = cos_theta > 0.0f && v.distance > 0.0f && v.image.x >= -reach && v.image.x < (float)cam->width + reach &&
+           v.image.y >= -reach && v.image.y < (float)cam->height + reach;
+  const float film_area = 4.0f * v3_length(right) * v3_length(up);
+  v.importance = 1.0f / (film_area * v.distance * v.distance * cos_theta * cos_theta * cos_theta);
+  return v;
+}
+
+// What one light path counts: rays traced and contributions dropped as NaN or infinite.
+typedef struct {
+  uint bounce_rays, camera_rays, nonfinite;
+} LightTally;
+
+// Splats `value` (the contribution before the camera's importance) where the camera sees
+// v from, if nothing lies between.
+FH_INLINE void connect_to_camera(RenderParams params, const SceneView* scene, const CameraView* v, lvec3 value,
+                                 volatile __global uint* splats, __global const float* density, LightTally* tally) {
+  const lvec3 c = v3_scale(value, v->importance);
+  if (!v3_any_positive(c)) return;
+  if (!(isfinite(c.x) && isfinite(c.y) && isfinite(c.z))) {
+    ++tally->nonfinite;
+    return;
+  }
+  ++tally->camera_rays;
+  const float3 org = (float3)(v->origin.x, v->origin.y, v->origin.z);
+  const float3 dir = (float3)(v->to_camera.x, v->to_camera.y, v->to_camera.z);
+  if (find_occluder(scene->nodes, scene->blocks, org, dir, 0.0f, v->distance * FH_SHADOW_SHORTEN) < 0)
+    splat(params, splats, density, v->image, c);
+}
+
+// The surface a light path reached: point, normals (the shading normal on the geometric
+// normal's side, as shade's shading_at gives it) and BSDF, textured.
+typedef struct {
+  SurfacePoint point;
+  lvec3 shading_normal;
+  Bsdf bsdf;
+} LightVertex;
+
+FH_INLINE LightVertex light_vertex(const SceneView* scene, TraceHit hit) {
+  LightVertex v;
+  v.point = surface_point(scene->triangles, hit.triangle, hit.b1, hit.b2);
+  const MaterialLanes m = material_lanes(scene->materials, scene->triangle_material[hit.triangle]);
+  v.bsdf = material_bsdf(&m);
+#if defined(FH_SHADING_NORMALS)
+  v.shading_normal = shading_normal(scene->normals, hit.triangle, hit.b1, hit.b2, v.point.normal);
+#else
+  v.shading_normal = v.point.normal;
+#endif
+#if defined(FH_TEXTURES)
+  v.bsdf.kd = texture_lookup(scene->texels, scene->texture_info, m.texture,
+                             surface_uv(scene->uvs, hit.triangle, hit.b1, hit.b2), v.bsdf.kd);
+#endif
+  return v;
+}
+
+// The adjoint weight of a BSDF sample taken with wo = w_in (toward where the light came
+// from): f(w_next <- w_in) |n.w_in| |g.w_next| / (|g.w_in| pdf), the shading normal's cosine
+// at the incoming side in place of the geometric one (Veach §5.3). Smooth lobes are
+// evaluated the other way round (the diffuse share depends on the outgoing direction); a
+// delta lobe's radiance weight is used without the 1/eta^2 of a refraction, which
+// radiance has and importance has not.
+FH_INLINE lvec3 adjoint_weight(const LightVertex* v, lvec3 n, lvec3 w_in, const BsdfSample* s) {
+  const float cos_g_in = fabs(v3_dot(v->point.normal, w_in)), cos_g_next = fabs(v3_dot(v->point.normal, s->wi));
+  const float correction = fabs(v3_dot(n, w_in)) * cos_g_next / cos_g_in;
+  if (s->pdf > 0.0f) return v3_scale(bsdf_eval(&v->bsdf, n, s->wi, w_in), correction / s->pdf);
+  lvec3 weight = v3_scale(s->weight, correction / fabs(v3_dot(n, s->wi)));
+#if defined(FH_GLASS)
+  const int refracted = v3_dot(v->point.normal, w_in) * v3_dot(v->point.normal, s->wi) < 0.0f;
+  if (has_lobe(&v->bsdf, FH_LOBE_GLASS) && refracted) {
+    const float eta = v3_dot(v->point.normal, w_in) >= 0.0f ? v->bsdf.eta : 1.0f / v->bsdf.eta;
+    weight = v3_scale(weight, eta * eta);
+  }
+#endif
+  return weight;
+}
+
+#endif
