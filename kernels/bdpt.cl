@@ -2,7 +2,8 @@
 // work-item traces a light subpath from the emitters and a camera subpath through its pixel,
 // and joins them in every way a path of at most max_depth scattering vertices can be made:
 //   s = 0   the camera subpath hits an emitter,
-//   s = 1   a camera vertex connected to a point on an emitter (the light table, uniform in area),
+//   s = 1   a camera vertex connected to a point on an emitter (the light table, uniform in area)
+//           or, with FH_ENV_MAP, to a direction drawn from the environment map,
 //   s >= 2  a camera vertex connected to each stored light vertex,
 //   t = 1   each light vertex connected to the pinhole, splatted where the camera sees it
 //           (light tracing, kernels/light_paths.h).
@@ -24,9 +25,19 @@
 //
 // Light vertices wait in `stored`, FH_BDPT_VERTEX_WORDS float4s each, max_depth per path: a
 // launch covers `count` paths from `first`, as many as the buffer holds.
+//
+// The environment map is a light like the triangles (picked with params.env_pick): its light
+// subpaths start on a disk as wide as the scene's bounding sphere (`sphere`: centre, radius),
+// facing a direction drawn from the map, beyond the sphere (Georgiev's background light), so
+// their first hit is at no finite distance from the light. A constant --env is found by
+// camera paths alone (as in the path tracer), with weight one.
 #include "camera.h"
 #include "film.h"
 #include "light_paths.h"
+// After the others: the host inlines each file once, at its first include, whatever the #if.
+#if defined(FH_ENV_MAP)
+#include "environment.h"
+#endif
 
 // A stored light vertex: (triangle bits, b1, b2, d_vcm), (w_in, d_vc), (alpha, scatterings).
 #define FH_BDPT_VERTEX_WORDS 3
@@ -71,26 +82,78 @@ FH_INLINE void weights_at_sample(float* d_vcm, float* d_vc, float pdf, float pdf
 // The light subpath's reach: its surface vertices (as light_trace.cl reaches them) stored
 // where a smooth lobe can connect them, each connected to the camera. Returns how many are
 // stored.
-FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, uint stream, uint path,
-                                   __global float4* stored, volatile __global uint* splats,
-                                   __global const float* density, LightTally* tally) {
-  uint dim = 0u, count = 0u;
-  const float u_pick = random_float(stream, path, dim++);
+// Where a light subpath starts: its first ray, its weight alpha (Le cos over the emission
+// density), the weights' state, and whether it comes from infinitely far (the map).
+typedef struct {
+  lvec3 org, dir, alpha;
+  float d_vcm, d_vc;
+  int valid, infinite;
+} LightStart;
+
+// A point uniform in the area of a light triangle, leaving its front cosine-distributed:
+// Le cos / (p_A cos / pi), the emission density p_A cos / pi against light sampling's p_A
+// (d_vcm) and against the camera hitting the light (d_vc).
+FH_INLINE LightStart start_on_triangle(RenderParams params, const SceneView* scene, float u_pick, float u1, float u2,
+                                       float u3, float u4) {
   const int light = scene->light_triangle[pick_light(scene->light_cdf, params.light_count, u_pick)];
-  const float u1 = random_float(stream, path, dim++), u2 = random_float(stream, path, dim++);
   const lvec2 b = sample_triangle(u1, u2);
   const SurfacePoint y = surface_point(scene->triangles, light, b.x, b.y);
   const float pdf_area = scene->light_pdf_area[light];
-  const lvec3 le = material_lanes(scene->materials, scene->triangle_material[light]).ke;
+  LightStart l;
+  l.dir = sample_cosine_hemisphere(y.normal, u3, u4);
+  const float cos_light = v3_dot(y.normal, l.dir);
+  l.valid = cos_light > 0.0f && pdf_area > 0.0f;
+  l.alpha = v3_scale(material_lanes(scene->materials, scene->triangle_material[light]).ke, M_PI_F / pdf_area);
+  l.d_vcm = mis2(M_PI_F / cos_light);
+  l.d_vc = mis2(M_PI_F / pdf_area);
+  l.org = offset_ray_origin(&y, l.dir);
+  l.infinite = 0;
+  return l;
+}
+
+#if defined(FH_ENV_MAP)
+// A direction w drawn from the map (density p_w, the pick's included) and a point uniform on
+// the disk of the scene's bounding sphere that faces it, beyond the sphere, the ray toward
+// -w: Le / (p_w / (pi R^2)); light sampling's density p_w against the emission density (d_vcm)
+// and no cosine at the light (d_vc).
+FH_INLINE LightStart start_from_environment(RenderParams params, const SceneView* scene, float4 sphere, float u1,
+                                            float u2, float u3, float u4) {
+  const EnvironmentSample e = environment_sample(params, scene->env_map, u1, u2);
+  const float pdf_w = params.env_pick * e.pdf, disk_area = M_PI_F * sphere.w * sphere.w;
+  lvec3 t, b;
+  orthonormal_basis(e.wi, &t, &b);
+  const lvec2 d = sample_concentric_disk(u3, u4);
+  LightStart l;
+  l.org = v3_add(v3(sphere.x, sphere.y, sphere.z),
+                 v3_scale(v3_add(e.wi, v3_add(v3_scale(t, d.x), v3_scale(b, d.y))), sphere.w));
+  l.dir = v3_neg(e.wi);
+  l.valid = pdf_w > 0.0f && disk_area > 0.0f;
+  l.alpha = v3_scale(e.radiance, disk_area / pdf_w);
+  l.d_vcm = mis2(disk_area);
+  l.d_vc = mis2(disk_area / pdf_w);
+  l.infinite = 1;
+  return l;
+}
+#endif
+
+FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, float4 sphere, uint stream,
+                                   uint path, __global float4* stored, volatile __global uint* splats,
+                                   __global const float* density, LightTally* tally) {
+  uint dim = 0u, count = 0u;
+  const float u_pick = random_float(stream, path, dim++);
+  const float u1 = random_float(stream, path, dim++), u2 = random_float(stream, path, dim++);
   const float u3 = random_float(stream, path, dim++), u4 = random_float(stream, path, dim++);
-  lvec3 dir = sample_cosine_hemisphere(y.normal, u3, u4);
-  const float cos_light = v3_dot(y.normal, dir);
-  if (!(cos_light > 0.0f) || !(pdf_area > 0.0f)) return 0u;
-  // Le cos / (p_A cos / pi); the emission density p_A cos / pi against light sampling's p_A
-  // (d_vcm) and against the camera hitting the light (d_vc).
-  lvec3 alpha = v3_scale(le, M_PI_F / pdf_area);
-  float d_vcm = mis2(M_PI_F / cos_light), d_vc = mis2(M_PI_F / pdf_area);
-  lvec3 org = offset_ray_origin(&y, dir);
+  LightStart start;
+  start.valid = 0;
+  (void)sphere;  // read with FH_ENV_MAP only
+#if defined(FH_ENV_MAP)
+  if (u_pick < params.env_pick) start = start_from_environment(params, scene, sphere, u1, u2, u3, u4);
+  else
+#endif
+  if (params.light_count > 0u) start = start_on_triangle(params, scene, u_pick, u1, u2, u3, u4);
+  if (!start.valid) return 0u;
+  lvec3 alpha = start.alpha, dir = start.dir, org = start.org;
+  float d_vcm = start.d_vcm, d_vc = start.d_vc;
   lvec3 carried = v3_splat(1.0f);
 
   for (uint scatterings = 1u; scatterings <= params.max_depth; ++scatterings) {
@@ -102,7 +165,8 @@ FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, 
     const lvec3 w_in = v3_neg(dir);
     const float cos_g_in = v3_dot(v.point.normal, w_in);
     if (cos_g_in == 0.0f) break;
-    weights_at_hit(&d_vcm, &d_vc, hit.t, fabs(cos_g_in));
+    // From the map, the first hit is at no distance the light's density knows of.
+    weights_at_hit(&d_vcm, &d_vc, start.infinite && scatterings == 1u ? 1.0f : hit.t, fabs(cos_g_in));
     const lvec3 g = cos_g_in > 0.0f ? v.point.normal : v3_neg(v.point.normal);
     const lvec3 n = cos_g_in > 0.0f ? v.shading_normal : v3_neg(v.shading_normal);
 
@@ -171,8 +235,8 @@ FH_INLINE int unoccluded(const SceneView* scene, lvec3 a, lvec3 b, LightTally* t
 }
 
 // s = 1: a point uniform in the area of a light triangle picked by the light table.
-FH_INLINE lvec3 connect_to_light(RenderParams params, const SceneView* scene, const CameraVertex* c, float u_pick,
-                                 float u1, float u2, LightTally* tally) {
+FH_INLINE lvec3 connect_to_triangle(RenderParams params, const SceneView* scene, const CameraVertex* c, float u_pick,
+                                    float u1, float u2, LightTally* tally) {
   const int light = scene->light_triangle[pick_light(scene->light_cdf, params.light_count, u_pick)];
   const lvec2 b = sample_triangle(u1, u2);
   const SurfacePoint y = surface_point(scene->triangles, light, b.x, b.y);
@@ -195,6 +259,42 @@ FH_INLINE lvec3 connect_to_light(RenderParams params, const SceneView* scene, co
   if (!v3_any_positive(value)) return v3_splat(0.0f);
   const lvec3 from = offset_ray_origin(&c->v.point, c->g), to = offset_ray_origin(&y, v3_neg(wi));
   return unoccluded(scene, from, to, tally) ? value : v3_splat(0.0f);
+}
+
+#if defined(FH_ENV_MAP)
+// s = 1 toward the map: a direction drawn from it (density p_w, the pick's included), against
+// BSDF sampling escaping that way and against the light subpaths from the map's disk
+// through this vertex (emission density p_w / (pi R^2), no cosine at the light).
+FH_INLINE lvec3 connect_to_environment(RenderParams params, const SceneView* scene, float4 sphere,
+                                       const CameraVertex* c, float u1, float u2, LightTally* tally) {
+  const EnvironmentSample e = environment_sample(params, scene->env_map, u1, u2);
+  const float pdf_w = params.env_pick * e.pdf;
+  const float cos_s = v3_dot(c->n, e.wi), cos_g = v3_dot(c->g, e.wi);
+  if (!(pdf_w > 0.0f && cos_s > 0.0f && cos_g > 0.0f)) return v3_splat(0.0f);
+  const lvec3 f = bsdf_eval(&c->v.bsdf, c->n, c->wo, e.wi);
+  const float w_light = mis2(bsdf_pdf(&c->v.bsdf, c->n, c->wo, e.wi) / pdf_w);
+  const float w_camera = mis2(cos_g / (M_PI_F * sphere.w * sphere.w)) *
+                         (c->d_vcm + c->d_vc * mis2(bsdf_pdf(&c->v.bsdf, c->n, e.wi, c->wo)));
+  const float weight = strategy_weight(1.0f / (w_light + 1.0f + w_camera), 1u, c->scatterings);
+  const lvec3 value = v3_scale(v3_mul(v3_mul(c->beta, f), e.radiance), cos_s * weight / pdf_w);
+  if (!v3_any_positive(value)) return v3_splat(0.0f);
+  const lvec3 from = offset_ray_origin(&c->v.point, c->g);
+  ++tally->camera_rays;
+  return find_occluder(scene->nodes, scene->blocks, (float3)(from.x, from.y, from.z),
+                       (float3)(e.wi.x, e.wi.y, e.wi.z), 0.0f, INFINITY) < 0
+             ? value
+             : v3_splat(0.0f);
+}
+#endif
+
+// s = 1: the light table's pick decides between the map and a triangle.
+FH_INLINE lvec3 connect_to_light(RenderParams params, const SceneView* scene, float4 sphere, const CameraVertex* c,
+                                 float u_pick, float u1, float u2, LightTally* tally) {
+  (void)sphere;  // read with FH_ENV_MAP only
+#if defined(FH_ENV_MAP)
+  if (u_pick < params.env_pick) return connect_to_environment(params, scene, sphere, c, u1, u2, tally);
+#endif
+  return params.light_count > 0u ? connect_to_triangle(params, scene, c, u_pick, u1, u2, tally) : v3_splat(0.0f);
 }
 
 // s >= 2: the camera vertex joined to a stored light vertex.
@@ -237,11 +337,11 @@ FH_INLINE lvec3 connect_vertices(const SceneView* scene, const CameraVertex* c, 
   return unoccluded(scene, from, to, tally) ? v3_scale(value, weight) : v3_splat(0.0f);
 }
 
-__kernel void bdpt(RenderParams params, uint pass, uint first, uint count, __global float4* stored,
+__kernel void bdpt(RenderParams params, uint pass, uint first, uint count, float4 sphere, __global float4* stored,
                    __global const float* filter_table, __global uint* splats, __global const float* density,
                    __global uint* tallies FH_SCENE_PARAMS) {
   const uint index = get_global_id(0);
-  if (index >= count || params.light_count == 0u) return;
+  if (index >= count) return;
   const uint path = first + index;
   if (path >= params.pixel_count) return;
   const SceneView scene = FH_SCENE_VIEW;
@@ -249,7 +349,7 @@ __kernel void bdpt(RenderParams params, uint pass, uint first, uint count, __glo
   LightTally tally = {0u, 0u, 0u};
   __global float4* own = stored + (size_t)index * params.max_depth * FH_BDPT_VERTEX_WORDS;
   const uint light_vertices =
-      trace_light_subpath(params, &scene, hash_combine(stream, 1u), path, own, splats, density, &tally);
+      trace_light_subpath(params, &scene, sphere, hash_combine(stream, 1u), path, own, splats, density, &tally);
 
   // The camera subpath through pixel `path`, its position offset by the filter.
   const uint camera_stream = hash_combine(stream, 2u);
@@ -274,7 +374,21 @@ __kernel void bdpt(RenderParams params, uint pass, uint first, uint count, __glo
     if (c.scatterings > 1u) ++tally.bounce_rays;  // the camera ray: the host counts one a pixel
     const TraceHit hit = trace_ray(scene.nodes, scene.blocks, (float3)(org.x, org.y, org.z),
                                    (float3)(dir.x, dir.y, dir.z), 0.0f, INFINITY);
-    if (hit.triangle < 0) break;
+    if (hit.triangle < 0) {
+      // Escaped: --env with weight one (no strategy but this finds it); the map weighed
+      // against light sampling (p_w) and the light subpaths from its disk (p_w / (pi R^2)).
+      sum = v3_add(sum, v3_mul(c.beta, v3_uniform(vload3(0, params.env))));
+#if defined(FH_ENV_MAP)
+      float env_pdf;
+      const lvec3 le = environment_lookup(params, scene.env_map, dir, &env_pdf);
+      const float pdf_w = params.env_pick * env_pdf;
+      const float w_camera = c.scatterings == 1u ? 0.0f
+                                                 : mis2(pdf_w) * c.d_vcm +
+                                                       mis2(pdf_w / (M_PI_F * sphere.w * sphere.w)) * c.d_vc;
+      sum = v3_add(sum, v3_scale(v3_mul(c.beta, le), strategy_weight(1.0f / (1.0f + w_camera), 0u, c.scatterings - 1u)));
+#endif
+      break;
+    }
     c.v = light_vertex(&scene, hit);
     c.wo = v3_neg(dir);
     const float cos_g = v3_dot(c.v.point.normal, c.wo);
@@ -300,7 +414,7 @@ __kernel void bdpt(RenderParams params, uint pass, uint first, uint count, __glo
     if (bsdf_has_smooth_lobe(&c.v.bsdf)) {
       const float u_pick = random_float(camera_stream, path, dim++);
       const float u1 = random_float(camera_stream, path, dim++), u2 = random_float(camera_stream, path, dim++);
-      sum = v3_add(sum, connect_to_light(params, &scene, &c, u_pick, u1, u2, &tally));
+      sum = v3_add(sum, connect_to_light(params, &scene, sphere, &c, u_pick, u1, u2, &tally));
       for (uint k = 0u; k < light_vertices; ++k) {
         __global const float4* s = own + FH_BDPT_VERTEX_WORDS * k;
         if (c.scatterings + (uint)s[2].w > params.max_depth) break;  // stored in order of scatterings

@@ -40,6 +40,8 @@ std::vector<ProgramSpec> everyProgramVariant() {
     for (unsigned bits = 0; bits < 16; ++bits)
       programs.push_back(
           lightTracerProgram(method, {(bits & 1) != 0, (bits & 2) != 0, (bits & 4) != 0, (bits & 8) != 0}, traversal));
+  // bdpt's light subpaths from the environment map too.
+  programs.push_back(lightTracerProgram(Method::BDPT, SceneFeatures::all(), traversal));
   for (Strategy strategy : {Strategy::Scalar, Strategy::Simd8, Strategy::Megakernel8})
     programs.push_back(pathTracerProgram(SceneFeatures::all(), Method::LT, traversal, strategy));
   return programs;

@@ -47,6 +47,8 @@ TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
       {"--method lt --adaptive", "--method lt traces light paths from the emitting triangles only and does not go with --adaptive"},
       {"--method lt --aovs albedo,spp", "--method lt records no first surfaces, which --aovs 'albedo,spp' asks for"},
       {"--method lt --denoise", "--method lt records no first surfaces, which --denoise needs"},
+      {"--method bdpt --adaptive", "--method bdpt does not go with --adaptive (its passes cover chosen pixels"},
+      {"--method bdpt --denoise", "--method bdpt records no first surfaces, which --denoise needs"},
   };
   for (const auto& [flags, message] : cases) {
     const auto r = test::runFredholm(std::string("render ") + flags + " -o " + dir + "/x.png");

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "base/test_hooks.h"
 #include "render/render.h"
 #include "scene/environment_map.h"
 #include "scene/icosphere.h"
@@ -115,7 +116,7 @@ Camera facingSquare(const float3& normal) {
 }
 
 class EveryMethod : public ::testing::TestWithParam<Method> {};
-INSTANTIATE_TEST_SUITE_P(Environment, EveryMethod, ::testing::Values(Method::PT, Method::NEE, Method::MIS),
+INSTANTIATE_TEST_SUITE_P(Environment, EveryMethod, ::testing::Values(Method::PT, Method::NEE, Method::MIS, Method::BDPT),
                          [](const ::testing::TestParamInfo<Method>& method) { return std::string(methodName(method.param)); });
 
 // A plane tilted by alpha from horizontal sees the sky through a view factor (1 + cos alpha)/2:
@@ -167,7 +168,7 @@ TEST_P(EveryMethod, VerticalPlaneUnderAQuarterOfTheSkyTurnedByRotate) {
 
 // A convex sphere of albedo 1 under a white map returns exactly the radiance it receives:
 // the image is the map's 1 everywhere, sphere or not.
-TEST_P(EveryMethod, WhiteFurnaceTheAlbedoOneSphereVanishes) {
+Film whiteFurnace(Method method, int spp) {
   test::SceneBuilder b;
   const int m = b.material(1.f);
   Scene scene = b.build();
@@ -179,16 +180,41 @@ TEST_P(EveryMethod, WhiteFurnaceTheAlbedoOneSphereVanishes) {
   }
   RenderSettings s = test::renderSettings();
   s.width = s.height = kSize;
-  s.spp = 64;
-  s.method = GetParam();
+  s.spp = spp;
+  s.method = method;
   s.envMap = mapOf(32, 16, [](int, int) { return float3{1.f, 1.f, 1.f}; });
-  const Film film = test::render(scene, lookingAt({0.f, 0.f, 3.f}, {0.f, 0.f, 0.f}, {0.f, 1.f, 0.f}, 45.f), s).film;
+  return test::render(scene, lookingAt({0.f, 0.f, 3.f}, {0.f, 0.f, 0.f}, {0.f, 1.f, 0.f}, 45.f), s).film;
+}
+
+void expectWhiteFurnace(Method method) {
+  const Film film = whiteFurnace(method, 64);
   expectMean(estimate(film), 1.0, "whole image");
   const Image image = film.image();
   for (size_t p = 0; p < film.pixels(); ++p) {
     const std::array<double, 3> v = film.varianceOfMean(p);
     for (size_t c = 0; c < 3; ++c)
       ASSERT_NEAR(image.rgb[3 * p + c], 1.0, 5.0 * std::sqrt(v[c]) + 1e-4) << "pixel " << p;
+  }
+}
+
+TEST_P(EveryMethod, WhiteFurnaceTheAlbedoOneSphereVanishes) { expectWhiteFurnace(GetParam()); }
+
+// bdpt's strategies toward the map, each alone at weight one (the test hook of
+// kernels/bdpt.cl, FH_BDPT_ONLY_S): the camera's escaping rays (s = 0), directions drawn from
+// the map (1), and light paths from the map's disk seen by the camera (2; off a convex sphere
+// no path has more than one bounce). Each must keep the furnace white, held in quarters of
+// the image: light tracing's pixels gather a few splats a pass, too few for a pixel's own
+// variance estimate to be trusted at five sigma.
+TEST(EnvironmentMap, BidirectionalStrategiesAloneKeepTheWhiteFurnace) {
+  for (int only : {0, 1, 2}) {
+    TestHooks hooks = testHooks();
+    hooks.bdptOnlyLightVertices = only;
+    const ScopedTestHooks strategy(hooks);
+    const std::string what = "bdpt, only s = " + std::to_string(only);
+    const Film film = whiteFurnace(Method::BDPT, 256);
+    for (size_t quarter = 0; quarter < 4; ++quarter)
+      expectMean(estimate(film, quarter * film.pixels() / 4, (quarter + 1) * film.pixels() / 4), 1.0,
+                 what + ", image quarter " + std::to_string(quarter));
   }
 }
 
@@ -207,15 +233,15 @@ TEST(EnvironmentMap, BesideATriangleLightEveryMethodAgrees) {
   s.width = s.height = kSize;
   s.spp = 256;
   s.envMap = upperEastQuarter(1.5f, 30.f);
-  std::vector<Estimate> halves[3];
-  const Method methods[] = {Method::PT, Method::NEE, Method::MIS};
-  for (int i = 0; i < 3; ++i) {
+  std::vector<Estimate> halves[4];
+  const Method methods[] = {Method::PT, Method::NEE, Method::MIS, Method::BDPT};
+  for (int i = 0; i < 4; ++i) {
     s.method = methods[i];
     const Film film = test::render(scene, camera, s).film;
     const size_t half = film.pixels() / 2;
     halves[i] = {estimate(film, 0, half), estimate(film, half, film.pixels())};
   }
-  for (int i = 1; i < 3; ++i)
+  for (int i = 1; i < 4; ++i)
     for (int h = 0; h < 2; ++h) {
       const Estimate &a = halves[0][size_t(h)], &e = halves[i][size_t(h)];
       EXPECT_NEAR(e.mean, a.mean, kSigmas * std::hypot(a.error, e.error))
@@ -239,7 +265,7 @@ TEST(EnvironmentMap, AConstantMapEqualsConstantEnv) {
   constant.method = Method::PT;
   constant.env = env;
   const Film reference = test::render(scene, camera, constant).film;
-  for (Method method : {Method::NEE, Method::MIS}) {
+  for (Method method : {Method::NEE, Method::MIS, Method::BDPT}) {
     RenderSettings s = test::renderSettings();
     s.width = s.height = kSize;
     s.spp = 256;

@@ -199,9 +199,10 @@ TEST_P(UnderOclgrind, RunsWithoutReports) {
   else if (run == "adaptive")  // later rounds' passes cover some pixels (render/adaptive.h)
     args = "render " + test::projectScene("failure/caustic.obj") +
            " --adaptive --width 8 --height 8 --spp 24 --wavefront 64 -o " + scenes.dir + "/adaptive.exr";
-  else if (run == "env")  // mis with an environment map beside the scene's light
+  else if (run == "env" || run == "bdpt_env")  // an environment map beside the scene's light
     args = "render " + scenes.features + " --env-map " + writeEnvironmentMap(scenes.dir) +
-           " --width 8 --height 8 --spp 1 --wavefront 64 -o " + scenes.dir + "/env.exr";
+           (run == "env" ? "" : " --method bdpt") + " --width 8 --height 8 --spp 1 --wavefront 64 -o " + scenes.dir +
+           "/" + run + ".exr";
   else
     args = "render " + scenes.features + " --method " + run + " --width 8 --height 8 --spp 1 --wavefront 64 -o " +
            scenes.dir + "/" + run + ".exr";
@@ -216,7 +217,8 @@ TEST_P(UnderOclgrind, RunsWithoutReports) {
   EXPECT_TRUE(reports.empty()) << run << ": Oclgrind reported:\n" << reports.substr(0, 4000);
 }
 
-INSTANTIATE_TEST_SUITE_P(Runs, UnderOclgrind, ::testing::Values("pt", "nee", "mis", "lt", "bdpt", "aov", "bench", "env", "adaptive"),
+INSTANTIATE_TEST_SUITE_P(Runs, UnderOclgrind, ::testing::Values("pt", "nee", "mis", "lt", "bdpt", "aov", "bench", "env", "bdpt_env",
+                                                          "adaptive"),
                          [](const ::testing::TestParamInfo<const char*>& p) { return std::string(p.param); });
 
 }  // namespace

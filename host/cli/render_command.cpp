@@ -112,16 +112,19 @@ void chunkOf(const RenderOptions& o, RenderSettings& s) {
   s.spp = int(end);
 }
 
-// Light tracing starts its paths on the scene's emitting triangles and splats them wherever
-// the camera sees them: what it cannot do yet is an error before any work.
+// Light tracing starts its paths on the scene's emitting triangles (bdpt also on the map) and
+// splats them wherever the camera sees them: what it cannot do yet is an error before any work.
 void lightTracingFits(const RenderOptions& o, const RenderSettings& s) {
+  // bdpt's camera subpaths find --env, and its light subpaths start on the map too.
+  const bool environments = s.method == Method::BDPT;
   const char* why = nullptr;
-  if (s.env != std::array<float, 3>{0.f, 0.f, 0.f}) why = "--env";
-  else if (!o.envMap.empty()) why = "--env-map";
+  if (!environments && s.env != std::array<float, 3>{0.f, 0.f, 0.f}) why = "--env";
+  else if (!environments && !o.envMap.empty()) why = "--env-map";
   else if (o.adaptive) why = "--adaptive (its passes cover chosen pixels; a light path lands anywhere)";
   if (why)
     throw Error(std::string("--method ") + methodName(s.method) +
-                " traces light paths from the emitting triangles only and does not go with " + why + "; use mis");
+                (environments ? "" : " traces light paths from the emitting triangles only and") + " does not go with " +
+                why + "; use mis");
 }
 
 // --method auto pilots each method in this process, on this process's devices: what must

@@ -75,6 +75,9 @@ class LightTracer : public PassRenderer {
   // bdpt: the filter's inverse CDF (camera paths) and the light vertices of one launch's paths.
   cl::Buffer filterTable_, lightVertices_;
   unsigned pathsPerLaunch_ = 0;
+  // bdpt: the scene's bounding sphere (centre, radius), where light subpaths from the
+  // environment map start.
+  cl_float4 sphere_{};
   std::array<Slot, kSlots> slots_;
   uint64_t nextLaunch_ = 0, granted_ = 0;  // local passes
   RenderStats stats_;
