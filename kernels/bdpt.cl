@@ -191,22 +191,10 @@ FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, 
     }
     if (scatterings == params.max_depth) break;
 
-    const float u0 = random_float(stream, path, dim++);
-    const float u5 = random_float(stream, path, dim++), u6 = random_float(stream, path, dim++);
-    const BsdfSample s = bsdf_sample(&v.bsdf, v.point.normal, v.shading_normal, w_in, u0, u5, u6);
+    const BsdfSample s = bounce_light_path(params, &v, n, w_in, scatterings, stream, path, &dim, &alpha, &carried);
     if (s.pdf == 0.0f) break;
     const float pdf_rev = s.pdf > 0.0f ? bsdf_pdf(&v.bsdf, n, s.wi, w_in) : 0.0f;
     weights_at_sample(&d_vcm, &d_vc, s.pdf, pdf_rev, fabs(v3_dot(v.point.normal, s.wi)));
-    const lvec3 weight = adjoint_weight(&v, n, w_in, &s);
-    alpha = v3_mul(alpha, weight);
-    carried = v3_mul(carried, weight);
-    if (scatterings >= params.rr_depth) {
-      const float survive = fmin(v3_max_component(carried), 0.95f);
-      if (random_float(stream, path, dim++) >= survive) break;
-      alpha = v3_scale(alpha, 1.0f / survive);
-      carried = v3_scale(carried, 1.0f / survive);
-    }
-    if (!v3_any_positive(alpha)) break;
     dir = s.wi;
     org = offset_ray_origin(&v.point, s.wi);
   }

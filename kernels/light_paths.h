@@ -1,7 +1,7 @@
 // What light paths share (light tracing, kernels/light_trace.cl; bidirectional path tracing,
 // kernels/bdpt.cl): contributions added as whole film quanta with integer atomics (splats),
 // the pinhole as a point sees it, the surfaces light paths reach and the adjoint weight of
-// their BSDF samples. One lane.
+// their BSDF samples, and a light path's bounce with its roulette. One lane.
 #ifndef FH_LIGHT_PATHS_H
 #define FH_LIGHT_PATHS_H
 
@@ -165,6 +165,34 @@ FH_INLINE lvec3 adjoint_weight(const LightVertex* v, lvec3 n, lvec3 w_in, const 
   }
 #endif
   return weight;
+}
+
+
+// A light path's next bounce from v: a BSDF sample with the light's side as wo, its adjoint
+// weight into alpha and into `carried` (the weights since the light, which roulette reads),
+// and Russian roulette from params.rr_depth scatterings on. Returns the sample; pdf 0: the
+// path ends there.
+FH_INLINE BsdfSample bounce_light_path(RenderParams params, const LightVertex* v, lvec3 n, lvec3 w_in,
+                                       uint scatterings, uint stream, uint path, uint* dim, lvec3* alpha,
+                                       lvec3* carried) {
+  const float u0 = random_float(stream, path, (*dim)++);
+  const float u1 = random_float(stream, path, (*dim)++), u2 = random_float(stream, path, (*dim)++);
+  BsdfSample s = bsdf_sample(&v->bsdf, v->point.normal, v->shading_normal, w_in, u0, u1, u2);
+  if (s.pdf == 0.0f) return s;
+  const lvec3 weight = adjoint_weight(v, n, w_in, &s);
+  *alpha = v3_mul(*alpha, weight);
+  *carried = v3_mul(*carried, weight);
+  if (scatterings >= params.rr_depth) {
+    const float survive = fmin(v3_max_component(*carried), 0.95f);
+    if (random_float(stream, path, (*dim)++) >= survive) {
+      s.pdf = 0.0f;
+      return s;
+    }
+    *alpha = v3_scale(*alpha, 1.0f / survive);
+    *carried = v3_scale(*carried, 1.0f / survive);
+  }
+  if (!v3_any_positive(*alpha)) s.pdf = 0.0f;
+  return s;
 }
 
 #endif

@@ -30,11 +30,13 @@ LightTable buildLightTable(const Scene& scene, const Bvh& bvh, const Environment
   for (size_t k = 0; k < bvh.order.size(); ++k) bvhIndexOf[bvh.order[k]] = int(k);
   LightTable table;
   table.pdfArea.assign(scene.triangleCount(), 0.f);
+  Vec3f lo, hi;
+  scene.bounds(lo, hi);
+  const double radius = lo[0] <= hi[0] ? 0.5 * std::sqrt(double(dot(hi - lo, hi - lo))) : 0.0;
+  if (lo[0] <= hi[0])
+    table.boundingSphere = {0.5f * (lo[0] + hi[0]), 0.5f * (lo[1] + hi[1]), 0.5f * (lo[2] + hi[2]), float(radius)};
   double environmentPower = 0.0;
   if (environment && environment->luminanceIntegral > 0.0) {
-    Vec3f lo, hi;
-    scene.bounds(lo, hi);
-    const double radius = 0.5 * std::sqrt(double(dot(hi - lo, hi - lo)));
     environmentPower = 3.14159265358979323846 * radius * radius * environment->luminanceIntegral;
     // A scene of one point (or none) still receives the map's light.
     if (!(environmentPower > 0.0) || !std::isfinite(environmentPower)) environmentPower = 1.0;

@@ -1,6 +1,7 @@
 // The scene in one device's memory: the BVH (DeviceBvh), per-triangle materials
 // in BVH order, the materials as the kernels see them, and the light-sampling tables.
 #pragma once
+#include <array>
 #include <vector>
 
 #include "accel/bvh.h"
@@ -25,6 +26,10 @@ struct LightTable {
   std::vector<int> triangle;
   std::vector<float> pdfArea;
   float environmentPick = 0.f;
+  // The scene's bounding sphere (centre, radius: half the box's diagonal; zero for a scene
+  // without triangles), whose disk the map's power goes through, and where bdpt's light
+  // paths from the map start (kernels/bdpt.cl).
+  std::array<float, 4> boundingSphere{};
 };
 
 LightTable buildLightTable(const Scene& scene, const Bvh& bvh, const EnvironmentMap* environment = nullptr);

@@ -3,7 +3,6 @@
 #include "render/light_tracer.h"
 
 #include <algorithm>
-#include <cmath>
 
 #include "base/test_hooks.h"
 #include "render/kernel_arguments.h"
@@ -19,27 +18,6 @@ constexpr size_t kSplatWords = 6;
 // a launch's light vertices may take.
 constexpr size_t kVertexBytes = 3 * 16;
 constexpr size_t kVertexBufferBytes = size_t(32) << 20;
-
-// The sphere about the triangles' bounding box (its centre, half its diagonal), which is
-// also the one the light table weighs the environment map's power by (device_scene.cpp).
-cl_float4 boundingSphere(const Bvh& bvh) {
-  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (size_t i = 0; i + 12 <= bvh.triangles.size(); i += 12)
-    for (size_t corner = 0; corner < 3; ++corner)
-      for (size_t k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], bvh.triangles[i + 4 * corner + k]);
-        hi[k] = std::max(hi[k], bvh.triangles[i + 4 * corner + k]);
-      }
-  cl_float4 sphere{};
-  if (!(lo[0] <= hi[0])) return sphere;  // no triangles
-  double diagonal2 = 0.0;
-  for (size_t k = 0; k < 3; ++k) {
-    sphere.s[k] = 0.5f * (lo[k] + hi[k]);
-    diagonal2 += double(hi[k] - lo[k]) * double(hi[k] - lo[k]);
-  }
-  sphere.s[3] = float(0.5 * std::sqrt(diagonal2));
-  return sphere;
-}
 
 }  // namespace
 
@@ -80,7 +58,7 @@ LightTracer::LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bv
     pathsPerLaunch_ = unsigned(std::min<size_t>(pixels_, std::max<size_t>(kVertexBufferBytes / perPath, 64)));
     lightVertices_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, pathsPerLaunch_ * perPath,
                                     "bidirectional light vertices");
-    sphere_ = boundingSphere(bvh);
+    for (size_t k = 0; k < 4; ++k) sphere_.s[k] = scene.lights.boundingSphere[k];
   }
   for (Slot& slot : slots_) {
     slot.splats = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, size_t(pixels_) * kSplatWords * 4,
