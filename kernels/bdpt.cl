@@ -34,6 +34,8 @@
 #include "camera.h"
 #include "film.h"
 #include "light_paths.h"
+#include "path_state.h"
+#include "sampler.h"
 // After the others: the host inlines each file once, at its first include, whatever the #if.
 #if defined(FH_ENV_MAP)
 #include "environment.h"
@@ -339,15 +341,15 @@ __kernel void bdpt(RenderParams params, uint pass, uint first, uint count, float
   const uint light_vertices =
       trace_light_subpath(params, &scene, sphere, hash_combine(stream, 1u), path, own, splats, density, &tally);
 
-  // The camera subpath through pixel `path`, its position offset by the filter.
-  const uint camera_stream = hash_combine(stream, 2u);
-  uint dim = 0u;
+  // The camera subpath through pixel `path`, its position offset by the filter. Its numbers
+  // are the pixel's own sequence, point `pass`, in the path tracer's dimensions
+  // (path_state.h): a pixel's first 2^k passes stratify each decision, as under mis.
+  const PixelSampler sampler = pixel_sampler_at(params.seed, pass, path, params.replicates);
   const CameraParams* cam = &params.camera;
   const uint width = (uint)cam->width;
-  const float px = (float)(path % width) + 0.5f +
-                   filter_offset(filter_table, params.filter_table_size, random_float(camera_stream, path, dim++));
-  const float py = (float)(path / width) + 0.5f +
-                   filter_offset(filter_table, params.filter_table_size, random_float(camera_stream, path, dim++));
+  const lvec2 u_pixel = sample_2d(&sampler, (luint)(FH_DIM_PIXEL));
+  const float px = (float)(path % width) + 0.5f + filter_offset(filter_table, params.filter_table_size, u_pixel.x);
+  const float py = (float)(path / width) + 0.5f + filter_offset(filter_table, params.filter_table_size, u_pixel.y);
   lvec3 dir = camera_ray_direction(cam, px, py);
   lvec3 org = v3_uniform(vload3(0, cam->origin));
   const float cos_camera = v3_dot(dir, v3_uniform(vload3(0, cam->forward)));
@@ -399,29 +401,28 @@ __kernel void bdpt(RenderParams params, uint pass, uint first, uint count, float
     }
     if (c.scatterings > params.max_depth) break;
 
+    const luint dim = (c.scatterings - 1u) * FH_DIMS_PER_BOUNCE;
     if (bsdf_has_smooth_lobe(&c.v.bsdf)) {
-      const float u_pick = random_float(camera_stream, path, dim++);
-      const float u1 = random_float(camera_stream, path, dim++), u2 = random_float(camera_stream, path, dim++);
-      sum = v3_add(sum, connect_to_light(params, &scene, sphere, &c, u_pick, u1, u2, &tally));
+      const lvec2 u = sample_2d(&sampler, dim + FH_DIM_LIGHT_U1);
+      sum = v3_add(sum, connect_to_light(params, &scene, sphere, &c, sample_1d(&sampler, dim + FH_DIM_LIGHT_PICK), u.x,
+                                         u.y, &tally));
       for (uint k = 0u; k < light_vertices; ++k) {
         __global const float4* s = own + FH_BDPT_VERTEX_WORDS * k;
         if (c.scatterings + (uint)s[2].w > params.max_depth) break;  // stored in order of scatterings
         sum = v3_add(sum, connect_vertices(&scene, &c, s, &tally));
       }
-    } else {
-      dim += 3u;
     }
 
-    const float u0 = random_float(camera_stream, path, dim++);
-    const float u5 = random_float(camera_stream, path, dim++), u6 = random_float(camera_stream, path, dim++);
-    const BsdfSample b = bsdf_sample(&c.v.bsdf, c.v.point.normal, c.v.shading_normal, c.wo, u0, u5, u6);
+    const lvec2 u = sample_2d(&sampler, dim + FH_DIM_BSDF_U1);
+    const BsdfSample b =
+        bsdf_sample(&c.v.bsdf, c.v.point.normal, c.v.shading_normal, c.wo, sample_1d(&sampler, dim + FH_DIM_BSDF_LOBE), u.x, u.y);
     if (b.pdf == 0.0f) break;
     const float pdf_rev = b.pdf > 0.0f ? bsdf_pdf(&c.v.bsdf, c.n, b.wi, c.wo) : 0.0f;
     weights_at_sample(&c.d_vcm, &c.d_vc, b.pdf, pdf_rev, fabs(v3_dot(c.v.point.normal, b.wi)));
     c.beta = v3_mul(c.beta, b.weight);
     if (c.scatterings >= params.rr_depth) {
       const float survive = fmin(v3_max_component(c.beta), 0.95f);
-      if (random_float(camera_stream, path, dim++) >= survive) break;
+      if (sample_1d(&sampler, dim + FH_DIM_ROULETTE) >= survive) break;
       c.beta = v3_scale(c.beta, 1.0f / survive);
     }
     if (!v3_any_positive(c.beta)) break;

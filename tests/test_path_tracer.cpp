@@ -109,7 +109,8 @@ Camera insideCamera() {
 }
 
 // The closed furnace for `method`.
-void expectClosedFurnace(Method method) {
+// blockShare 1: the image mean alone (blocks untested), for an estimator of infinite variance.
+void expectClosedFurnace(Method method, double blockShare = 0.05) {
   RenderSettings s = test::renderSettings();
   s.method = method;
   s.width = s.height = 16;
@@ -123,7 +124,7 @@ void expectClosedFurnace(Method method) {
     EXPECT_EQ(r.stats.nonfinite, 0u);
     EXPECT_EQ(r.stats.samples, 16u * 16u * 256u);
     expectMatches(r.film, [&](size_t) { return le / (1.0 - rho); },
-                  std::string(methodName(method)) + ", rho " + std::to_string(rho));
+                  std::string(methodName(method)) + ", rho " + std::to_string(rho), blockShare);
   }
 }
 
@@ -1052,7 +1053,11 @@ INSTANTIATE_TEST_SUITE_P(Methods, LightTracing, ::testing::Values(Method::LT, Me
 // light sampled by area (s = 1), light tracing then connections to the first light vertex
 // (s = 2), and to the second (s = 3). Each must reach the closed forms alone, which the
 // weighted images cannot show: a strategy's wrong contribution would hide under a weight
-// that keeps it small.
+// that keeps it small. In the closed box, s = 1 alone has infinite variance: a camera vertex
+// and a light point near the same edge of two walls join with G ~ 1/d^2, whose square does
+// not integrate. A sample's variance then says too little of a 4x4 block's error (blocks
+// that miss the rare large values come out low by several of their sigmas), so there it is
+// held by the image mean only; the plane, which no emitter touches, holds it by blocks too.
 TEST(Bidirectional, EachStrategyAloneReachesTheClosedForms) {
   for (int only : {0, 1, 2, 3}) {
     TestHooks hooks = testHooks();
@@ -1060,7 +1065,7 @@ TEST(Bidirectional, EachStrategyAloneReachesTheClosedForms) {
     const ScopedTestHooks strategy(hooks);
     const std::string what = "bdpt, only s = " + std::to_string(only);
     SCOPED_TRACE(what);
-    expectClosedFurnace(Method::BDPT);
+    expectClosedFurnace(Method::BDPT, only == 1 ? 1.0 : 0.05);
     expectLambertsPlane(PlaneUnderLight::scene(), Method::BDPT, what);
   }
 }
