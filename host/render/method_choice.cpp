@@ -71,6 +71,13 @@ RenderSettings pilotSettings(const RenderSettings& s, Method method, int side, i
   return p;
 }
 
+// The seconds a render's samples take at its steady rate: its first pass, which compiles the
+// method's kernels (or finds them cached) and waits for the devices to start, not counted, so
+// that a pilot's cost does not depend on what an earlier run left in the program cache.
+double steadySeconds(const RenderStats& st) {
+  return st.steadySamplesPerSecond > 0 ? double(st.samples) / st.steadySamplesPerSecond : st.seconds;
+}
+
 }  // namespace
 
 MethodChoice chooseMethod(const std::vector<DeviceInfo>& devices, const Scene& scene, const Bvh& bvh,
@@ -80,12 +87,11 @@ MethodChoice chooseMethod(const std::vector<DeviceInfo>& devices, const Scene& s
   RenderLinks links;
   links.stop = stop;
   const std::vector<Method> methods = methodsFor(scene, s);
-  // mis's samples per second, from a short render (its first pass, compiling and waiting on
-  // the others, not counted), and so the render's expected time and the pilots' samples.
+  // mis's samples per second, from a short render, and so the render's expected time and the
+  // pilots' samples.
   const RenderSettings timing = pilotSettings(s, Method::MIS, kMaxPilotSide / 2, int(kNoiseMinPasses));
   const RenderResult timed = render(devices, scene, bvh, camera, timing, links);
-  const double perSecond = timed.stats.steadySamplesPerSecond > 0 ? timed.stats.steadySamplesPerSecond
-                                                                  : double(timed.stats.samples) / timed.stats.seconds;
+  const double perSecond = double(timed.stats.samples) / steadySeconds(timed.stats);
   const double atMisSpeed = double(s.width) * s.height * s.spp / perSecond;
   const double renderSeconds = s.seconds > 0 ? std::min(s.seconds, atMisSpeed) : atMisSpeed;
   const PilotSize size =
@@ -98,7 +104,7 @@ MethodChoice chooseMethod(const std::vector<DeviceInfo>& devices, const Scene& s
     choice.pilotHeight = p.height;
     const RenderResult r = render(devices, scene, bvh, camera, p, links);
     if (r.stopped || !r.complete) break;
-    choice.trials.push_back({method, r.stats.seconds, r.film.estimatedRelMse()});
+    choice.trials.push_back({method, steadySeconds(r.stats), r.film.estimatedRelMse()});
   }
   choice.method = cheapestMethod(choice.trials);
   choice.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
