@@ -26,7 +26,9 @@ std::vector<Method> methodsFor(const Scene& scene, const RenderSettings& s) {
   if (scene.lights.empty() && !s.envMap) methods.push_back(Method::PT);
   methods.insert(methods.end(), {Method::NEE, Method::MIS});
   const bool environment = s.env != std::array<float, 3>{0.f, 0.f, 0.f} || s.envMap;
-  if (!scene.lights.empty() && !environment && !s.adaptive && !s.surfaceAovs) methods.push_back(Method::LT);
+  const bool lightPaths = !s.adaptive && !s.surfaceAovs;  // what neither lt nor bdpt can do
+  if (!scene.lights.empty() && !environment && lightPaths) methods.push_back(Method::LT);
+  if ((!scene.lights.empty() || s.envMap) && lightPaths) methods.push_back(Method::BDPT);
   return methods;
 }
 
