@@ -414,8 +414,8 @@ __kernel void bdpt(RenderParams params, uint pass, uint first, uint count, float
     }
 
     const lvec2 u = sample_2d(&sampler, dim + FH_DIM_BSDF_U1);
-    const BsdfSample b =
-        bsdf_sample(&c.v.bsdf, c.v.point.normal, c.v.shading_normal, c.wo, sample_1d(&sampler, dim + FH_DIM_BSDF_LOBE), u.x, u.y);
+    const BsdfSample b = bsdf_sample(&c.v.bsdf, c.v.point.normal, c.v.shading_normal, c.wo,
+                                     sample_1d(&sampler, dim + FH_DIM_BSDF_LOBE), u.x, u.y);
     if (b.pdf == 0.0f) break;
     const float pdf_rev = b.pdf > 0.0f ? bsdf_pdf(&c.v.bsdf, c.n, b.wi, c.wo) : 0.0f;
     weights_at_sample(&c.d_vcm, &c.d_vc, b.pdf, pdf_rev, fabs(v3_dot(c.v.point.normal, b.wi)));
