@@ -52,6 +52,12 @@ double pixelVariance(const Film& f, size_t p) {
   return (v[0] + v[1] + v[2]) / 3.0;
 }
 
+// The share of 4x4 blocks expectMatches lets fail, and a share that lets every block fail:
+// the image mean alone is held (for an estimator of infinite variance, whose blocks a
+// sample's variance cannot judge).
+constexpr double kBlockShare = 0.05;
+constexpr double kImageMeanOnly = 1.0;
+
 // Compares the render with `expected(p)` per pixel (NaN: skip the pixel): the image mean
 // by a z-test, and 4x4-pixel blocks by z-tests of which at most `blockShare` may fail at
 // |z| > 3.29 (0.1 % two-sided each for a normal mean). Blocks rather than pixels: at a
@@ -59,7 +65,7 @@ double pixelVariance(const Film& f, size_t p) {
 // small light by chance, next-event samples next to an emitter's edge), and measured
 // per-pixel failure rates were 1-6 % on correct renders.
 void expectMatches(const Film& f, const std::function<double(size_t)>& expected, const std::string& what,
-                   double blockShare = 0.05) {
+                   double blockShare = kBlockShare) {
   const int block = 4;
   double diffSum = 0, varSum = 0;
   size_t blocks = 0, outliers = 0;
@@ -109,8 +115,7 @@ Camera insideCamera() {
 }
 
 // The closed furnace for `method`.
-// blockShare 1: the image mean alone (blocks untested), for an estimator of infinite variance.
-void expectClosedFurnace(Method method, double blockShare = 0.05) {
+void expectClosedFurnace(Method method, double blockShare = kBlockShare) {
   RenderSettings s = test::renderSettings();
   s.method = method;
   s.width = s.height = 16;
@@ -1065,7 +1070,7 @@ TEST(Bidirectional, EachStrategyAloneReachesTheClosedForms) {
     const ScopedTestHooks strategy(hooks);
     const std::string what = "bdpt, only s = " + std::to_string(only);
     SCOPED_TRACE(what);
-    expectClosedFurnace(Method::BDPT, only == 1 ? 1.0 : 0.05);
+    expectClosedFurnace(Method::BDPT, only == 1 ? kImageMeanOnly : kBlockShare);
     expectLambertsPlane(PlaneUnderLight::scene(), Method::BDPT, what);
   }
 }
