@@ -50,6 +50,21 @@ TEST(MethodChoice, ALongerRenderGetsALargerPilot) {
   EXPECT_EQ(pilotSize(1e3, 20).side, 20);
 }
 
+// Pilots are of equal time, so a slow method's is short of passes: its time budget, however
+// soon spent, leaves it the passes of a noise estimate (RenderSettings::minPasses), and a
+// render without that floor still renders one pass.
+TEST(MethodChoice, APilotRendersItsLeastPassesHoweverShortItsTime) {
+  const Scene scene = loadDefaultScene();
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = 8;
+  s.spp = 1000;
+  s.seconds = 1e-9;
+  s.minPasses = kNoiseMinPasses;
+  EXPECT_EQ(test::render(scene, scene.camera, s).film.passes(), kNoiseMinPasses);
+  s.minPasses = 1;
+  EXPECT_EQ(test::render(scene, scene.camera, s).film.passes(), 1u);
+}
+
 TEST(MethodChoice, LightPathsArePilotedWhereTheyCanRenderTheScene) {
   const Scene cornell = loadDefaultScene();
   RenderSettings s;
@@ -100,9 +115,12 @@ void expectChoice(const AutoRender& r, const std::string& method, size_t methods
   EXPECT_EQ(r.stats["method"], method);
   ASSERT_EQ(choice["methods"].size(), methods) << choice.dump(2);
   std::vector<MethodTrial> pilots;
+  EXPECT_GT(choice["pilot_seconds"].get<double>(), 0.0);
   for (const auto& [name, trial] : choice["methods"].items()) {
     EXPECT_GT(trial["relmse"].get<double>(), 0.0) << name;
     EXPECT_GT(trial["seconds"].get<double>(), 0.0) << name;
+    EXPECT_GE(trial["passes"].get<unsigned>(), kNoiseMinPasses) << name;
+    EXPECT_LE(trial["passes"].get<unsigned>(), unsigned(kMaxPilotSpp)) << name;
     pilots.push_back({parseMethod(name), trial["seconds"], trial["relmse"]});
   }
   EXPECT_EQ(methodName(cheapestMethod(pilots)), method);

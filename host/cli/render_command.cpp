@@ -355,9 +355,9 @@ MethodChoice choosePilotedMethod(const std::vector<DeviceInfo>& devices, const S
   settings.method = choice.method;
   settings.fingerprint = renderFingerprint(scene, camera, settings);
   if (settings.seconds > 0) settings.seconds = std::max(settings.seconds - choice.seconds, 1e-6);
-  std::cerr << "fredholm: --method auto chose " << methodName(choice.method) << " (relMSE x seconds of a "
-            << choice.pilotWidth << "x" << choice.pilotHeight << ", " << choice.pilotSpp
-            << "-spp pilot: " << choice.describeCosts() << "; pilots took " << formatSeconds(choice.seconds) << " s)\n";
+  std::cerr << "fredholm: --method auto chose " << methodName(choice.method) << " (relMSE x seconds of "
+            << choice.pilotWidth << "x" << choice.pilotHeight << " pilots of " << formatSeconds(choice.pilotSeconds)
+            << " s each: " << choice.describeCosts() << "; pilots took " << formatSeconds(choice.seconds) << " s)\n";
   return choice;
 }
 
@@ -365,9 +365,11 @@ MethodChoice choosePilotedMethod(const std::vector<DeviceInfo>& devices, const S
 nlohmann::json choiceJson(const MethodChoice& c) {
   nlohmann::json methods = nlohmann::json::object();
   for (const MethodTrial& t : c.trials)
-    methods[methodName(t.method)] = {{"seconds", t.seconds}, {"relmse", t.relMse}, {"cost", t.cost()}};
-  return {{"chosen", methodName(c.method)}, {"margin", kChoiceMargin},   {"pilot_width", c.pilotWidth},
-          {"pilot_height", c.pilotHeight},  {"pilot_spp", c.pilotSpp}, {"seconds", c.seconds},
+    methods[methodName(t.method)] = {
+        {"seconds", t.seconds}, {"relmse", t.relMse}, {"cost", t.cost()}, {"passes", t.passes}};
+  return {{"chosen", methodName(c.method)},   {"margin", kChoiceMargin},
+          {"pilot_width", c.pilotWidth},      {"pilot_height", c.pilotHeight},
+          {"pilot_seconds", c.pilotSeconds},  {"seconds", c.seconds},
           {"methods", methods}};
 }
 
@@ -498,8 +500,8 @@ int runRender(RenderOptions o) {
   std::map<std::string, std::string> metadata = imageMetadata(o, scene, r, method, spp, seconds, estimatedRelMse);
   if (settings.adaptive) metadata["adaptive"] = "1";
   if (choice)
-    metadata["method_choice"] = "auto: relMSE x seconds of a " + std::to_string(choice->pilotWidth) + "x" +
-                                std::to_string(choice->pilotHeight) + " pilot: " + choice->describeCosts();
+    metadata["method_choice"] = "auto: relMSE x seconds of " + std::to_string(choice->pilotWidth) + "x" +
+                                std::to_string(choice->pilotHeight) + " pilots: " + choice->describeCosts();
   const Image image = r.film.imageWithLayers(layers);
   const std::string passes = std::to_string(r.film.passes()) + " passes";
   // The files, and the live view's last frame: the image as written.

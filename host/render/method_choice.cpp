@@ -15,7 +15,7 @@ std::string MethodChoice::describeCosts() const {
   std::string text;
   for (const MethodTrial& t : trials) {
     char cost[32];
-    std::snprintf(cost, sizeof cost, "%.2e", t.cost());
+    std::snprintf(cost, sizeof cost, "%.2e (%u spp)", t.cost(), t.passes);
     text += (text.empty() ? "" : ", ") + std::string(methodName(t.method)) + " " + cost;
   }
   return text;
@@ -55,9 +55,10 @@ PilotSize pilotSize(double samples, int imageSide) {
 namespace {
 
 // The render's settings for a pilot of `method`: the image scaled to `side` pixels on its
-// longer side (its aspect kept), `passes` passes with two replicates for the noise estimate,
-// nothing saved or shown.
-RenderSettings pilotSettings(const RenderSettings& s, Method method, int side, int passes) {
+// longer side (its aspect kept), `passes` passes or as many as `seconds` allow (0: no time
+// budget; kNoiseMinPasses at least), two replicates for the noise estimate, nothing saved or
+// shown.
+RenderSettings pilotSettings(const RenderSettings& s, Method method, int side, int passes, double seconds) {
   RenderSettings p = s;
   const double scale = std::min(1.0, double(side) / double(std::max(s.width, s.height)));
   p.width = std::max(1, int(std::lround(s.width * scale)));
@@ -65,7 +66,8 @@ RenderSettings pilotSettings(const RenderSettings& s, Method method, int side, i
   p.method = method;
   p.spp = passes;
   p.firstPass = 0;
-  p.seconds = 0.0;
+  p.seconds = seconds;
+  p.minPasses = kNoiseMinPasses;
   // A target no image meets but a black one: two replicates, and every pass rendered.
   p.noise = 1e-300;
   p.progress = false;
@@ -91,22 +93,21 @@ MethodChoice chooseMethod(const std::vector<DeviceInfo>& devices, const Scene& s
   const std::vector<Method> methods = methodsFor(scene, s);
   // mis's samples per second, from a short render, and so the render's expected time and the
   // pilots' samples.
-  const RenderSettings timing = pilotSettings(s, Method::MIS, kMaxPilotSide / 2, int(kNoiseMinPasses));
+  const RenderSettings timing = pilotSettings(s, Method::MIS, kMaxPilotSide / 2, int(kNoiseMinPasses), 0.0);
   const RenderResult timed = render(devices, scene, bvh, camera, timing, links);
   const double perSecond = double(timed.stats.samples) / steadySeconds(timed.stats);
   const double atMisSpeed = double(s.width) * s.height * s.spp / perSecond;
   const double renderSeconds = s.seconds > 0 ? std::min(s.seconds, atMisSpeed) : atMisSpeed;
-  const PilotSize size =
-      pilotSize(kPilotShare * renderSeconds * perSecond / double(methods.size()), std::max(s.width, s.height));
-  choice.pilotSpp = size.passes;
+  choice.pilotSeconds = kPilotShare * renderSeconds / double(methods.size());
+  const PilotSize size = pilotSize(choice.pilotSeconds * perSecond, std::max(s.width, s.height));
   for (Method method : methods) {
     if (links.stopRequested()) break;
-    const RenderSettings p = pilotSettings(s, method, size.side, size.passes);
+    const RenderSettings p = pilotSettings(s, method, size.side, kMaxPilotSpp, choice.pilotSeconds);
     choice.pilotWidth = p.width;
     choice.pilotHeight = p.height;
     const RenderResult r = render(devices, scene, bvh, camera, p, links);
     if (r.stopped || !r.complete) break;
-    choice.trials.push_back({method, steadySeconds(r.stats), r.film.estimatedRelMse()});
+    choice.trials.push_back({method, steadySeconds(r.stats), r.film.estimatedRelMse(), unsigned(r.film.passes())});
   }
   choice.method = cheapestMethod(choice.trials);
   choice.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -20,13 +20,15 @@ namespace fh {
 // Another method is chosen over mis only where its pilot cost is below this share of mis's.
 constexpr double kChoiceMargin = 0.8;
 // The pilot: each method renders the same image, the render's scaled down (its aspect kept),
-// for the same number of passes, taking about kPilotShare of the render's expected time
-// between them (a short mis render gives mis's samples per second; the render's time is its
-// --time, or its samples at that speed). The budget goes to the image's size first, from
-// kMinPilotSide to kMaxPilotSide pixels on its longer side at kMinPilotSpp passes (enough
-// for the noise estimate, whose halves need kNoiseMinPasses between them), then to passes,
-// up to kMaxPilotSpp. A longer pilot sees more of a heavy-tailed method's rare samples:
-// the longer the render, the surer its choice.
+// for the same time, kPilotShare of the render's expected time between them (a short mis
+// render gives mis's samples per second; the render's time is its --time, or its samples at
+// that speed). Equal times, not equal samples: a slow method's pilot costs no more than a
+// fast one's, and the cost compared is error per unit of time either way. The image's size
+// is set by mis's samples in its time: from kMinPilotSide to kMaxPilotSide pixels on its
+// longer side at kMinPilotSpp passes, then passes up to kMaxPilotSpp. A slower method renders
+// fewer passes in its time, never fewer than kNoiseMinPasses (its noise estimate's halves).
+// A longer pilot sees more of a heavy-tailed method's rare samples: the longer the render,
+// the surer its choice.
 constexpr double kPilotShare = 0.05;
 constexpr int kMinPilotSide = 32, kMaxPilotSide = 128;
 constexpr int kMinPilotSpp = 64, kMaxPilotSpp = 1024;
@@ -35,15 +37,17 @@ struct MethodTrial {
   Method method = Method::MIS;
   double seconds = 0.0;  // the pilot's render time (set-up and compiling excluded)
   double relMse = 0.0;   // the pilot image's estimated relMSE
+  unsigned passes = 0;   // the pilot's passes (samples per pixel)
   double cost() const { return relMse * seconds; }
 };
 
 struct MethodChoice {
   Method method = Method::MIS;
-  int pilotWidth = 0, pilotHeight = 0, pilotSpp = 0;
-  double seconds = 0.0;  // the whole pilot, set-up included
+  int pilotWidth = 0, pilotHeight = 0;
+  double pilotSeconds = 0.0;  // each method's pilot time budget
+  double seconds = 0.0;       // the whole pilot, set-up included
   std::vector<MethodTrial> trials;
-  // "pt 3.3e-02, nee 7.7e-03, mis 8.4e-03, lt 5.5e-03": each trial's cost.
+  // "nee 7.7e-03 (96 spp), mis 8.4e-03 (90 spp), lt 5.5e-03 (41 spp)": each trial's cost.
   std::string describeCosts() const;
 };
 
@@ -59,8 +63,8 @@ std::vector<Method> methodsFor(const Scene& scene, const RenderSettings& s);
 // kChoiceMargin, else mis.
 Method cheapestMethod(const std::vector<MethodTrial>& trials);
 
-// The pilot's longer side and passes for `samples` samples per method, within the bounds
-// above (the side no larger than the image's).
+// The pilot's longer side, and mis's passes, for `samples` of mis's samples per method,
+// within the bounds above (the side no larger than the image's).
 struct PilotSize {
   int side = kMinPilotSide, passes = kMinPilotSpp;
 };

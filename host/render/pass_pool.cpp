@@ -105,9 +105,9 @@ PassPool::NewPass PassPool::nextNewPass(uint32_t& pass) {
     ledgerDry_ = true;  // ask no more: for another process, each question is a message
     return NewPass::None;
   }
-  // However short the time budget, a render renders one pass: an image of nothing would
-  // answer no one's question.
-  if (next_ >= total_ || (next_ > firstNew_ && stop_.outOfTime())) return NewPass::None;
+  // However short the time budget, a render renders its least passes (RenderSettings::minPasses).
+  const bool fewest = next_ - firstNew_ < std::max(1u, settings_.minPasses);
+  if (next_ >= total_ || (!fewest && stop_.outOfTime())) return NewPass::None;
   const PassRounds::Round* round = rounds_.roundOf(next_);
   if (!round) return NewPass::Later;
   if (!rounds_.takeFromBudget(*round)) return NewPass::None;

@@ -47,6 +47,9 @@ struct RenderSettings {
   // film that merges with the other chunks' (fredholm merge) into the image of all of them.
   uint32_t firstPass = 0;
   double seconds = 0.0;  // time budget: stop at the end of the pass running when it is spent
+  // With a time budget, the passes rendered however soon it is spent (a render of nothing
+  // answers no one's question; --method auto's pilots need a noise estimate's worth).
+  uint32_t minPasses = 1;
   // Noise target: stop once the film's estimated relMSE (Film::estimatedRelMse) is at most
   // this, checked after each pass from kNoiseMinPasses on; 0: none.
   double noise = 0.0;
