@@ -119,8 +119,13 @@ void expectChoice(const AutoRender& r, const std::string& method, size_t methods
   for (const auto& [name, trial] : choice["methods"].items()) {
     EXPECT_GT(trial["relmse"].get<double>(), 0.0) << name;
     EXPECT_GT(trial["seconds"].get<double>(), 0.0) << name;
-    EXPECT_GE(trial["passes"].get<unsigned>(), kNoiseMinPasses) << name;
-    EXPECT_LE(trial["passes"].get<unsigned>(), unsigned(kMaxPilotSpp)) << name;
+    // However short the render, each pilot has the smallest pilot's samples at least.
+    const unsigned passes = trial["passes"];
+    EXPECT_GE(passes, kNoiseMinPasses) << name;
+    EXPECT_LE(passes, unsigned(kMaxPilotSpp)) << name;
+    EXPECT_GE(double(passes) * choice["pilot_width"].get<int>() * choice["pilot_height"].get<int>(),
+              double(kMinPilotSide) * kMinPilotSide * kMinPilotSpp)
+        << name;
     pilots.push_back({parseMethod(name), trial["seconds"], trial["relmse"]});
   }
   EXPECT_EQ(methodName(cheapestMethod(pilots)), method);

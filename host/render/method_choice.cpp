@@ -67,7 +67,10 @@ RenderSettings pilotSettings(const RenderSettings& s, Method method, int side, i
   p.spp = passes;
   p.firstPass = 0;
   p.seconds = seconds;
-  p.minPasses = kNoiseMinPasses;
+  // The least a pilot's estimate is worth: kMinPilotSpp passes of the smallest pilot's
+  // pixels, in passes of this image (kNoiseMinPasses at least).
+  const double leastSamples = double(kMinPilotSide) * kMinPilotSide * kMinPilotSpp;
+  p.minPasses = std::max(kNoiseMinPasses, unsigned(std::ceil(leastSamples / (double(p.width) * p.height))));
   // A target no image meets but a black one: two replicates, and every pass rendered.
   p.noise = 1e-300;
   p.progress = false;

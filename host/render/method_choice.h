@@ -26,7 +26,9 @@ constexpr double kChoiceMargin = 0.8;
 // fast one's, and the cost compared is error per unit of time either way. The image's size
 // is set by mis's samples in its time: from kMinPilotSide to kMaxPilotSide pixels on its
 // longer side at kMinPilotSpp passes, then passes up to kMaxPilotSpp. A slower method renders
-// fewer passes in its time, never fewer than kNoiseMinPasses (its noise estimate's halves).
+// fewer passes in its time, but never fewer samples than the smallest pilot's (kMinPilotSpp
+// passes of kMinPilotSide²: below that, estimates of a heavy-tailed method's noise came out
+// several times off) nor fewer passes than kNoiseMinPasses (its noise estimate's halves).
 // A longer pilot sees more of a heavy-tailed method's rare samples: the longer the render,
 // the surer its choice.
 constexpr double kPilotShare = 0.05;
