@@ -68,12 +68,12 @@ TEST(MethodChoice, APilotRendersItsLeastPassesHoweverShortItsTime) {
 TEST(MethodChoice, LightPathsArePilotedWhereTheyCanRenderTheScene) {
   const Scene cornell = loadDefaultScene();
   RenderSettings s;
-  EXPECT_EQ(methodsFor(cornell, s), (std::vector<Method>{Method::NEE, Method::MIS, Method::LT, Method::BDPT}));
-  const std::vector<Method> cameraOnly = {Method::NEE, Method::MIS};
+  EXPECT_EQ(methodsFor(cornell, s), (std::vector<Method>{Method::MIS, Method::LT, Method::BDPT}));
+  const std::vector<Method> cameraOnly = {Method::MIS};
   // An environment: bdpt's camera subpaths find it, light tracing's paths cannot.
   RenderSettings env = s;
   env.env = {0.1f, 0.1f, 0.1f};
-  EXPECT_EQ(methodsFor(cornell, env), (std::vector<Method>{Method::NEE, Method::MIS, Method::BDPT}));
+  EXPECT_EQ(methodsFor(cornell, env), (std::vector<Method>{Method::MIS, Method::BDPT}));
   RenderSettings adaptive = s;
   adaptive.adaptive = true;
   EXPECT_EQ(methodsFor(cornell, adaptive), cameraOnly);
@@ -83,11 +83,11 @@ TEST(MethodChoice, LightPathsArePilotedWhereTheyCanRenderTheScene) {
   // Lit by a constant environment alone: nothing to sample as a light, and pt is piloted.
   Scene dark = cornell;
   dark.lights.clear();
-  EXPECT_EQ(methodsFor(dark, env), (std::vector<Method>{Method::PT, Method::NEE, Method::MIS}));
+  EXPECT_EQ(methodsFor(dark, env), (std::vector<Method>{Method::PT, Method::MIS}));
   // Lit by a map alone: bdpt's light subpaths start on it.
   RenderSettings map = s;
   map.envMap = std::make_shared<EnvironmentMap>();
-  EXPECT_EQ(methodsFor(dark, map), (std::vector<Method>{Method::NEE, Method::MIS, Method::BDPT}));
+  EXPECT_EQ(methodsFor(dark, map), (std::vector<Method>{Method::MIS, Method::BDPT}));
 }
 
 struct AutoRender {
@@ -137,7 +137,7 @@ void expectChoice(const AutoRender& r, const std::string& method, size_t methods
 }
 
 TEST(MethodChoiceCli, TheCornellBoxGetsMis) {
-  expectChoice(renderAuto(test::projectScene("cornell-box/CornellBox-Original.obj"), ""), "mis", 4);
+  expectChoice(renderAuto(test::projectScene("cornell-box/CornellBox-Original.obj"), ""), "mis", 3);
 }
 
 // The caustic is carried by light paths: light tracing's lead over mis shows in a pilot of
@@ -148,7 +148,7 @@ TEST(MethodChoiceCli, TheCausticSceneGetsLightPaths) {
   ASSERT_EQ(r.run.exitCode, 0) << r.run.output;
   const std::string chosen = r.stats["method_choice"]["chosen"];
   EXPECT_TRUE(chosen == "lt" || chosen == "bdpt") << r.stats["method_choice"].dump(2);
-  expectChoice(r, chosen, 4);
+  expectChoice(r, chosen, 3);
 }
 
 // With a constant environment nothing starts at the lights alone: no lt pilot; bdpt's
@@ -156,7 +156,7 @@ TEST(MethodChoiceCli, TheCausticSceneGetsLightPaths) {
 TEST(MethodChoiceCli, AnEnvironmentLeavesLightTracingOut) {
   const AutoRender r = renderAuto(test::projectScene("cornell-box/CornellBox-Original.obj"), "--env 0.2,0.2,0.2");
   ASSERT_EQ(r.run.exitCode, 0) << r.run.output;
-  EXPECT_EQ(r.stats["method_choice"]["methods"].size(), 3u);
+  EXPECT_EQ(r.stats["method_choice"]["methods"].size(), 2u);
   EXPECT_FALSE(r.stats["method_choice"]["methods"].contains("lt"));
   EXPECT_TRUE(r.stats["method_choice"]["methods"].contains("bdpt"));
 }

@@ -24,7 +24,7 @@ std::string MethodChoice::describeCosts() const {
 std::vector<Method> methodsFor(const Scene& scene, const RenderSettings& s) {
   std::vector<Method> methods;
   if (scene.lights.empty() && !s.envMap) methods.push_back(Method::PT);
-  methods.insert(methods.end(), {Method::NEE, Method::MIS});
+  methods.push_back(Method::MIS);
   const bool environment = s.env != std::array<float, 3>{0.f, 0.f, 0.f} || s.envMap;
   const bool lightPaths = !s.adaptive && !s.surfaceAovs;  // what neither lt nor bdpt can do
   if (!scene.lights.empty() && !environment && lightPaths) methods.push_back(Method::LT);
