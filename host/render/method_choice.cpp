@@ -56,8 +56,7 @@ namespace {
 
 // The render's settings for a pilot of `method`: the image scaled to `side` pixels on its
 // longer side (its aspect kept), `passes` passes or as many as `seconds` allow (0: no time
-// budget; kNoiseMinPasses at least), two replicates for the noise estimate, nothing saved or
-// shown.
+// budget), two replicates for the noise estimate, nothing saved or shown.
 RenderSettings pilotSettings(const RenderSettings& s, Method method, int side, int passes, double seconds) {
   RenderSettings p = s;
   const double scale = std::min(1.0, double(side) / double(std::max(s.width, s.height)));

@@ -49,7 +49,8 @@ struct MethodChoice {
   double pilotSeconds = 0.0;  // each method's pilot time budget
   double seconds = 0.0;       // the whole pilot, set-up included
   std::vector<MethodTrial> trials;
-  // "nee 7.7e-03 (96 spp), mis 8.4e-03 (90 spp), lt 5.5e-03 (41 spp)": each trial's cost.
+  // "mis 8.4e-03 (90 spp), lt 5.5e-03 (41 spp), bdpt 4.6e-03 (16 spp)": each trial's cost
+  // and passes.
   std::string describeCosts() const;
 };
 
