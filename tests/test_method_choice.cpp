@@ -96,7 +96,8 @@ struct AutoRender {
   std::string image;
 };
 
-AutoRender renderAuto(const std::string& scene, const std::string& flags, const std::string& budget = "--spp 1") {
+// The budget: a render long enough for pilots (a fifth of it holds the smallest).
+AutoRender renderAuto(const std::string& scene, const std::string& flags, const std::string& budget = "--spp 256") {
   const std::string dir = test::tempDir("auto");
   AutoRender r;
   r.image = dir + "/auto.exr";
@@ -115,6 +116,7 @@ void expectChoice(const AutoRender& r, const std::string& method, size_t methods
   EXPECT_EQ(r.stats["method"], method);
   ASSERT_EQ(choice["methods"].size(), methods) << choice.dump(2);
   std::vector<MethodTrial> pilots;
+  EXPECT_TRUE(choice["piloted"].get<bool>());
   EXPECT_GT(choice["pilot_seconds"].get<double>(), 0.0);
   for (const auto& [name, trial] : choice["methods"].items()) {
     EXPECT_GT(trial["relmse"].get<double>(), 0.0) << name;
@@ -151,6 +153,22 @@ TEST(MethodChoiceCli, TheCausticSceneGetsLightPaths) {
   expectChoice(r, chosen, 3);
 }
 
+// A render so short that even the smallest pilots would take more than a fifth of it cannot
+// gain from them: it is mis's, and says so.
+TEST(MethodChoiceCli, ARenderTooShortForPilotsIsMisWithoutThem) {
+  const AutoRender r = renderAuto(test::projectScene("failure/caustic.obj"), "", "--spp 1");
+  ASSERT_EQ(r.run.exitCode, 0) << r.run.output;
+  const nlohmann::json& choice = r.stats["method_choice"];
+  EXPECT_EQ(choice["chosen"], "mis");
+  EXPECT_EQ(r.stats["method"], "mis");
+  EXPECT_FALSE(choice["piloted"].get<bool>());
+  EXPECT_TRUE(choice["methods"].empty()) << choice.dump(2);
+  EXPECT_GT(choice["least_pilot_seconds"].get<double>(), kMostPilotShare * choice["render_seconds"].get<double>());
+  EXPECT_NE(r.run.output.find("--method auto chose mis without pilots: the smallest would take about "),
+            std::string::npos)
+      << r.run.output;
+}
+
 // With a constant environment nothing starts at the lights alone: no lt pilot; bdpt's
 // camera subpaths find the environment.
 TEST(MethodChoiceCli, AnEnvironmentLeavesLightTracingOut) {
@@ -169,7 +187,7 @@ TEST(MethodChoiceCli, TheImageIsTheChosenMethodsImageForTheSeed) {
   const std::string method = r.stats["method"];
   const std::string dir = test::tempDir("auto");
   const auto plain = test::runFredholm("render " + scene + " --method " + method +
-                                       " --width 128 --height 128 --spp 1 --seed 5 -o " + dir + "/plain.exr");
+                                       " --width 128 --height 128 --spp 256 --seed 5 -o " + dir + "/plain.exr");
   ASSERT_EQ(plain.exitCode, 0) << plain.output;
   EXPECT_EQ(readImage(r.image).rgb, readImage(dir + "/plain.exr").rgb) << method;
 }

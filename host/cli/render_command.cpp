@@ -355,6 +355,12 @@ MethodChoice choosePilotedMethod(const std::vector<DeviceInfo>& devices, const S
   settings.method = choice.method;
   settings.fingerprint = renderFingerprint(scene, camera, settings);
   if (settings.seconds > 0) settings.seconds = std::max(settings.seconds - choice.seconds, 1e-6);
+  if (!choice.piloted()) {
+    std::cerr << "fredholm: --method auto chose mis without pilots: the smallest would take about "
+              << formatSeconds(choice.leastPilotSeconds) << " s of the render's " << formatSeconds(choice.renderSeconds)
+              << " s, more than a fifth\n";
+    return choice;
+  }
   std::cerr << "fredholm: --method auto chose " << methodName(choice.method) << " (relMSE x seconds of "
             << choice.pilotWidth << "x" << choice.pilotHeight << " pilots of " << formatSeconds(choice.pilotSeconds)
             << " s each: " << choice.describeCosts() << "; pilots took " << formatSeconds(choice.seconds) << " s)\n";
@@ -367,9 +373,15 @@ nlohmann::json choiceJson(const MethodChoice& c) {
   for (const MethodTrial& t : c.trials)
     methods[methodName(t.method)] = {
         {"seconds", t.seconds}, {"relmse", t.relMse}, {"cost", t.cost()}, {"passes", t.passes}};
-  return {{"chosen", methodName(c.method)},   {"margin", kChoiceMargin},
-          {"pilot_width", c.pilotWidth},      {"pilot_height", c.pilotHeight},
-          {"pilot_seconds", c.pilotSeconds},  {"seconds", c.seconds},
+  return {{"chosen", methodName(c.method)},
+          {"margin", kChoiceMargin},
+          {"piloted", c.piloted()},
+          {"render_seconds", c.renderSeconds},
+          {"least_pilot_seconds", c.leastPilotSeconds},
+          {"pilot_width", c.pilotWidth},
+          {"pilot_height", c.pilotHeight},
+          {"pilot_seconds", c.pilotSeconds},
+          {"seconds", c.seconds},
           {"methods", methods}};
 }
 
@@ -500,8 +512,10 @@ int runRender(RenderOptions o) {
   std::map<std::string, std::string> metadata = imageMetadata(o, scene, r, method, spp, seconds, estimatedRelMse);
   if (settings.adaptive) metadata["adaptive"] = "1";
   if (choice)
-    metadata["method_choice"] = "auto: relMSE x seconds of " + std::to_string(choice->pilotWidth) + "x" +
-                                std::to_string(choice->pilotHeight) + " pilots: " + choice->describeCosts();
+    metadata["method_choice"] = choice->piloted() ? "auto: relMSE x seconds of " + std::to_string(choice->pilotWidth) +
+                                                        "x" + std::to_string(choice->pilotHeight) +
+                                                        " pilots: " + choice->describeCosts()
+                                                  : "auto: mis without pilots (the render too short for them)";
   const Image image = r.film.imageWithLayers(layers);
   const std::string passes = std::to_string(r.film.passes()) + " passes";
   // The files, and the live view's last frame: the image as written.

@@ -68,8 +68,7 @@ RenderSettings pilotSettings(const RenderSettings& s, Method method, int side, i
   p.seconds = seconds;
   // The least a pilot's estimate is worth: kMinPilotSpp passes of the smallest pilot's
   // pixels, in passes of this image (kNoiseMinPasses at least).
-  const double leastSamples = double(kMinPilotSide) * kMinPilotSide * kMinPilotSpp;
-  p.minPasses = std::max(kNoiseMinPasses, unsigned(std::ceil(leastSamples / (double(p.width) * p.height))));
+  p.minPasses = std::max(kNoiseMinPasses, unsigned(std::ceil(kLeastPilotSamples / (double(p.width) * p.height))));
   // A target no image meets but a black one: two replicates, and every pass rendered.
   p.noise = 1e-300;
   p.progress = false;
@@ -99,8 +98,15 @@ MethodChoice chooseMethod(const std::vector<DeviceInfo>& devices, const Scene& s
   const RenderResult timed = render(devices, scene, bvh, camera, timing, links);
   const double perSecond = double(timed.stats.samples) / steadySeconds(timed.stats);
   const double atMisSpeed = double(s.width) * s.height * s.spp / perSecond;
-  const double renderSeconds = s.seconds > 0 ? std::min(s.seconds, atMisSpeed) : atMisSpeed;
-  choice.pilotSeconds = kPilotShare * renderSeconds / double(methods.size());
+  choice.renderSeconds = s.seconds > 0 ? std::min(s.seconds, atMisSpeed) : atMisSpeed;
+  // The smallest pilots at mis's steady speed: an estimate from below (slower methods take
+  // longer, and each pilot sets up), so that pilots are left out only where they cannot pay.
+  choice.leastPilotSeconds = double(methods.size()) * kLeastPilotSamples / perSecond;
+  if (!choice.piloted()) {
+    choice.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return choice;  // mis
+  }
+  choice.pilotSeconds = kPilotShare * choice.renderSeconds / double(methods.size());
   const PilotSize size = pilotSize(choice.pilotSeconds * perSecond, std::max(s.width, s.height));
   for (Method method : methods) {
     if (links.stopRequested()) break;

@@ -34,6 +34,11 @@ constexpr double kChoiceMargin = 0.8;
 constexpr double kPilotShare = 0.05;
 constexpr int kMinPilotSide = 32, kMaxPilotSide = 128;
 constexpr int kMinPilotSpp = 64, kMaxPilotSpp = 1024;
+constexpr double kLeastPilotSamples = double(kMinPilotSide) * kMinPilotSide * kMinPilotSpp;
+// Pilots that would take more than this share of the render leave it no chance to come
+// within 1.25x of the best method's error (1 - 1 / 1.25), however right their choice: where
+// even the smallest would, none run and the render is mis's.
+constexpr double kMostPilotShare = 0.2;
 
 struct MethodTrial {
   Method method = Method::MIS;
@@ -48,6 +53,10 @@ struct MethodChoice {
   int pilotWidth = 0, pilotHeight = 0;
   double pilotSeconds = 0.0;  // each method's pilot time budget
   double seconds = 0.0;       // the whole pilot, set-up included
+  // The render's expected seconds at mis's speed, and what the smallest pilots would take of
+  // them at that speed (more than kMostPilotShare: no pilots, `trials` empty).
+  double renderSeconds = 0.0, leastPilotSeconds = 0.0;
+  bool piloted() const { return leastPilotSeconds <= kMostPilotShare * renderSeconds; }
   std::vector<MethodTrial> trials;
   // "mis 8.4e-03 (90 spp), lt 5.5e-03 (41 spp), bdpt 4.6e-03 (16 spp)": each trial's cost
   // and passes.
@@ -58,8 +67,9 @@ struct MethodChoice {
 // (its light samples, at about its time a sample: nee's error at equal time has been
 // 0.86-1.02 of mis's wherever measured, never past kChoiceMargin, so its pilot could win
 // only by luck); pt only where nothing can be sampled as a light (no emitting triangle, no
-// --env-map: mis is then pt with shadow rays that find nothing); lt where the scene has emitting triangles and nothing it
-// cannot do is asked (an environment, adaptive passes, first-surface layers); bdpt where
+// --env-map: mis is then pt with shadow rays that find nothing); lt where the scene has
+// emitting triangles and nothing it cannot do is asked (an environment, adaptive passes,
+// first-surface layers); bdpt where
 // light subpaths have somewhere to start (emitting triangles or --env-map) and neither
 // adaptive passes nor first-surface layers are asked.
 std::vector<Method> methodsFor(const Scene& scene, const RenderSettings& s);
