@@ -34,20 +34,13 @@ TEST(MethodChoice, AnotherMethodMustBeatMisByTheMargin) {
   EXPECT_EQ(cheapestMethod({{Method::MIS, 1.0, 1.0}, {Method::LT, 3.0, 0.5}}), Method::MIS);
 }
 
-// The pilots' samples go to the image's size first, then to passes.
+// mis's pilot samples go to the image's size, at kMinPilotSpp passes, up to the largest side.
 TEST(MethodChoice, ALongerRenderGetsALargerPilot) {
-  const PilotSize least = pilotSize(1000.0, 512);  // a render of a moment: the smallest pilot
-  EXPECT_EQ(least.side, kMinPilotSide);
-  EXPECT_EQ(least.passes, kMinPilotSpp);
-  const PilotSize middle = pilotSize(double(kMinPilotSpp) * 80 * 80, 512);
-  EXPECT_EQ(middle.side, 80);
-  EXPECT_EQ(middle.passes, kMinPilotSpp);
-  const PilotSize longer = pilotSize(300.0 * kMaxPilotSide * kMaxPilotSide, 512);
-  EXPECT_EQ(longer.side, kMaxPilotSide);
-  EXPECT_EQ(longer.passes, 300);
-  EXPECT_EQ(pilotSize(1e12, 512).passes, kMaxPilotSpp);
-  EXPECT_EQ(pilotSize(1e12, 20).side, 20);  // never larger than the image
-  EXPECT_EQ(pilotSize(1e3, 20).side, 20);
+  EXPECT_EQ(pilotSide(1000.0, 512), kMinPilotSide);  // a render of a moment: the smallest pilot
+  EXPECT_EQ(pilotSide(double(kMinPilotSpp) * 80 * 80, 512), 80);
+  EXPECT_EQ(pilotSide(300.0 * kMaxPilotSide * kMaxPilotSide, 512), kMaxPilotSide);
+  EXPECT_EQ(pilotSide(1e12, 20), 20);  // never larger than the image
+  EXPECT_EQ(pilotSide(1e3, 20), 20);
 }
 
 // Pilots are of equal time, so a slow method's is short of passes: its time budget, however

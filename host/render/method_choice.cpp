@@ -41,15 +41,11 @@ Method cheapestMethod(const std::vector<MethodTrial>& trials) {
   return best->cost() < kChoiceMargin * mis->cost() ? best->method : Method::MIS;
 }
 
-PilotSize pilotSize(double samples, int imageSide) {
-  PilotSize size;
+int pilotSide(double samples, int imageSide) {
   const int largest = std::max(1, std::min(kMaxPilotSide, imageSide));
   // Square pixels count: the side's square bounds the pixels whatever the aspect.
   const double side = std::sqrt(std::max(samples, 0.0) / kMinPilotSpp);
-  size.side = std::clamp(int(side), std::min(kMinPilotSide, largest), largest);
-  const double passes = samples / (double(size.side) * size.side);
-  size.passes = int(std::clamp(passes, double(kMinPilotSpp), double(kMaxPilotSpp)));
-  return size;
+  return std::clamp(int(side), std::min(kMinPilotSide, largest), largest);
 }
 
 namespace {
@@ -107,10 +103,10 @@ MethodChoice chooseMethod(const std::vector<DeviceInfo>& devices, const Scene& s
     return choice;  // mis
   }
   choice.pilotSeconds = kPilotShare * choice.renderSeconds / double(methods.size());
-  const PilotSize size = pilotSize(choice.pilotSeconds * perSecond, std::max(s.width, s.height));
+  const int side = pilotSide(choice.pilotSeconds * perSecond, std::max(s.width, s.height));
   for (Method method : methods) {
     if (links.stopRequested()) break;
-    const RenderSettings p = pilotSettings(s, method, size.side, kMaxPilotSpp, choice.pilotSeconds);
+    const RenderSettings p = pilotSettings(s, method, side, kMaxPilotSpp, choice.pilotSeconds);
     choice.pilotWidth = p.width;
     choice.pilotHeight = p.height;
     const RenderResult r = render(devices, scene, bvh, camera, p, links);

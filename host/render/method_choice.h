@@ -78,12 +78,10 @@ std::vector<Method> methodsFor(const Scene& scene, const RenderSettings& s);
 // kChoiceMargin, else mis.
 Method cheapestMethod(const std::vector<MethodTrial>& trials);
 
-// The pilot's longer side, and mis's passes, for `samples` of mis's samples per method,
-// within the bounds above (the side no larger than the image's).
-struct PilotSize {
-  int side = kMinPilotSide, passes = kMinPilotSpp;
-};
-PilotSize pilotSize(double samples, int imageSide);
+// The pilot's longer side for `samples` of mis's samples per method: the side at which they
+// make kMinPilotSpp passes, within the bounds above and no larger than the image's. (The
+// passes are each pilot's own, as many as its time allows.)
+int pilotSide(double samples, int imageSide);
 
 // Runs the pilots on the render's devices and chooses. `stop` (as RenderLinks::stop) ends
 // the pilot early; the choice is then mis.
