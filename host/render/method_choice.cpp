@@ -98,22 +98,20 @@ MethodChoice chooseMethod(const std::vector<DeviceInfo>& devices, const Scene& s
   // The smallest pilots at mis's steady speed: an estimate from below (slower methods take
   // longer, and each pilot sets up), so that pilots are left out only where they cannot pay.
   choice.leastPilotSeconds = double(methods.size()) * kLeastPilotSamples / perSecond;
-  if (!choice.piloted()) {
-    choice.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return choice;  // mis
+  if (choice.piloted()) {
+    choice.pilotSeconds = kPilotShare * choice.renderSeconds / double(methods.size());
+    const int side = pilotSide(choice.pilotSeconds * perSecond, std::max(s.width, s.height));
+    for (Method method : methods) {
+      if (links.stopRequested()) break;
+      const RenderSettings p = pilotSettings(s, method, side, kMaxPilotSpp, choice.pilotSeconds);
+      choice.pilotWidth = p.width;
+      choice.pilotHeight = p.height;
+      const RenderResult r = render(devices, scene, bvh, camera, p, links);
+      if (r.stopped || !r.complete) break;
+      choice.trials.push_back({method, steadySeconds(r.stats), r.film.estimatedRelMse(), unsigned(r.film.passes())});
+    }
   }
-  choice.pilotSeconds = kPilotShare * choice.renderSeconds / double(methods.size());
-  const int side = pilotSide(choice.pilotSeconds * perSecond, std::max(s.width, s.height));
-  for (Method method : methods) {
-    if (links.stopRequested()) break;
-    const RenderSettings p = pilotSettings(s, method, side, kMaxPilotSpp, choice.pilotSeconds);
-    choice.pilotWidth = p.width;
-    choice.pilotHeight = p.height;
-    const RenderResult r = render(devices, scene, bvh, camera, p, links);
-    if (r.stopped || !r.complete) break;
-    choice.trials.push_back({method, steadySeconds(r.stats), r.film.estimatedRelMse(), unsigned(r.film.passes())});
-  }
-  choice.method = cheapestMethod(choice.trials);
+  choice.method = cheapestMethod(choice.trials);  // mis where no pilot ran
   choice.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return choice;
 }

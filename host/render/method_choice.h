@@ -69,9 +69,8 @@ struct MethodChoice {
 // only by luck); pt only where nothing can be sampled as a light (no emitting triangle, no
 // --env-map: mis is then pt with shadow rays that find nothing); lt where the scene has
 // emitting triangles and nothing it cannot do is asked (an environment, adaptive passes,
-// first-surface layers); bdpt where
-// light subpaths have somewhere to start (emitting triangles or --env-map) and neither
-// adaptive passes nor first-surface layers are asked.
+// first-surface layers); bdpt where light subpaths have somewhere to start (emitting
+// triangles or --env-map) and neither adaptive passes nor first-surface layers are asked.
 std::vector<Method> methodsFor(const Scene& scene, const RenderSettings& s);
 
 // Of the trials, the method the render should use: the cheapest where it beats mis's cost by
