@@ -5,9 +5,11 @@
 // estimator on PoCL.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -31,12 +33,16 @@ struct Target {
   const char* name;
   const char* flags;  // target triple and what it needs
   const char* output; // what to emit: every target runs its backend where one exists
+  FeatureSpan span;   // the material feature sets compiled
 };
 
+// SPIR's front end checks every variant a scene can ask for. The two back ends, which take
+// most of the time, compile every kernel with none and with all of the features: both sides
+// of every feature switch (FeatureSwitches.NoConditionNamesTwoFeatures below).
 const Target kTargets[] = {
-    {"spir64", "-target spir64", "-emit-llvm -c"},
-    {"nvptx64", "-target nvptx64-nvidia-nvcl", "-S"},
-    {"amdgcn", "-target amdgcn-amd-amdhsa -mcpu=gfx900 -nogpulib", "-S"},
+    {"spir64", "-target spir64", "-emit-llvm -c", FeatureSpan::EveryCombination},
+    {"nvptx64", "-target nvptx64-nvidia-nvcl", "-S", FeatureSpan::NoneAndAll},
+    {"amdgcn", "-target amdgcn-amd-amdhsa -mcpu=gfx900 -nogpulib", "-S", FeatureSpan::NoneAndAll},
 };
 
 // OpenCL C 1.2 as a device compiler sees it: the standard header, no optional extension
@@ -54,10 +60,10 @@ struct Compiled {
   test::CommandResult result;
 };
 
-// Compiles every program variant with `flags` on all cores; returns the failures.
-std::vector<Compiled> compileEveryVariant(const std::string& tag, const std::string& flags,
-                                          const std::string& output) {
-  const std::vector<ProgramSpec> programs = everyProgramVariant();
+// Compiles the program variants of `span` with `flags` on all cores; returns each result.
+std::vector<Compiled> compileVariants(FeatureSpan span, const std::string& tag, const std::string& flags,
+                                      const std::string& output) {
+  const std::vector<ProgramSpec> programs = programVariants(span);
   const std::string dir = test::tempDir(tag);
   std::vector<Compiled> results(programs.size());
   std::atomic<size_t> next{0};
@@ -82,9 +88,10 @@ class OfflineCompile : public ::testing::TestWithParam<Target> {};
 TEST_P(OfflineCompile, EveryProgramVariantWithoutErrorsOrWarnings) {
   ASSERT_TRUE(fs::exists(FREDHOLM_CLANG)) << "clang not found (" << FREDHOLM_CLANG << "): apt-get install clang";
   const Target& target = GetParam();
-  const auto results = compileEveryVariant(target.name, std::string(kStrict) + " " + kWarnings + " -O2 " + target.flags,
-                                           target.output);
-  EXPECT_GE(results.size(), 51u);  // intersect, bench rays, aov, 3 methods x 16 feature sets
+  const auto results = compileVariants(target.span, target.name,
+                                       std::string(kStrict) + " " + kWarnings + " -O2 " + target.flags, target.output);
+  // intersect, bench rays, aov, 3 methods x 2 strategies x the feature sets
+  EXPECT_GE(results.size(), target.span == FeatureSpan::EveryCombination ? 99u : 15u);
   for (const auto& r : results)
     EXPECT_TRUE(r.result.exitCode == 0 && r.result.output.empty())
         << target.name << ": " << r.program << " (exit " << r.result.exitCode << "):\n" << r.result.output;
@@ -93,6 +100,99 @@ TEST_P(OfflineCompile, EveryProgramVariantWithoutErrorsOrWarnings) {
 INSTANTIATE_TEST_SUITE_P(Targets, OfflineCompile, ::testing::ValuesIn(kTargets),
                          [](const ::testing::TestParamInfo<Target>& p) { return std::string(p.param.name); });
 
+// The back ends' span holds if no kernel code depends on two features together: no
+// preprocessor condition names two feature macros, and none naming a feature sits inside
+// another feature's condition. Read in each program's source as the host assembles it
+// (includes inlined), so a condition around an #include counts as the included code's.
+TEST(FeatureSwitches, NoConditionNamesTwoFeatures) {
+  const std::vector<std::string> macros = featureMacros();
+  ASSERT_EQ(macros.size(), 5u);  // glossy, glass, textures, vertex normals, environment map
+  const std::regex directive(R"(^\s*#\s*(if|ifdef|ifndef|elif|else|endif)\b(.*))"),
+      marker(R"re(^\s*#\s*line\s+(\d+)\s+"([^"]*)")re");
+  size_t featureConditions = 0;
+  std::set<std::string> reported;
+  for (const ProgramSpec& program : programVariants(FeatureSpan::NoneAndAll)) {
+    std::istringstream source(assembleKernelSources(program.files));
+    std::vector<std::set<std::string>> open;  // the feature macros each open condition names
+    std::string line, file = program.name;
+    std::smatch m;
+    for (int number = 1; std::getline(source, line); ++number) {
+      if (std::regex_search(line, m, marker)) {  // the host's markers: where the next line comes from
+        number = std::stoi(m[1].str()) - 1;
+        file = m[2].str();
+        continue;
+      }
+      if (!std::regex_search(line, m, directive)) continue;
+      const std::string kind = m[1].str(), condition = m[2].str();
+      if (kind == "endif") {
+        ASSERT_FALSE(open.empty()) << file << ":" << number << ": an #endif without its #if";
+        open.pop_back();
+        continue;
+      }
+      if (kind == "else") continue;
+      std::set<std::string> named;
+      for (const std::string& macro : macros)
+        if (std::regex_search(condition, std::regex("\\b" + macro + "\\b"))) named.insert(macro);
+      std::set<std::string> outer;
+      for (size_t i = 0; i + (kind == "elif" ? 1 : 0) < open.size(); ++i) outer.insert(open[i].begin(), open[i].end());
+      for (const std::string& macro : named) outer.erase(macro);
+      featureConditions += !named.empty();
+      const std::string where = file + ":" + std::to_string(number);
+      const bool twoFeatures = named.size() >= 2 || (!named.empty() && !outer.empty());
+      if (twoFeatures && reported.insert(where).second)  // once, though many programs include it
+        ADD_FAILURE() << where << ": '" << line << "' makes code depend on two features; compile every combination "
+            << "on every target (FeatureSpan)";
+      if (kind == "elif")
+        open.back().insert(named.begin(), named.end());
+      else
+        open.push_back(named);
+    }
+  }
+  EXPECT_GT(featureConditions, 20u);  // the scan saw the feature switches
+}
+
+// The back ends compile each program of the front end's catalogue (its kernel files and
+// options but the feature macros) with no feature and with every feature it is ever built
+// with, and nothing the front end does not also compile.
+TEST(FeatureSwitches, BackEndsBuildEachProgramWithNoneAndAll) {
+  const std::vector<std::string> macros = featureMacros();
+  // A program without its feature macros, and those macros.
+  auto split = [&](const ProgramSpec& p) {
+    std::string rest, token;
+    std::set<std::string> features;
+    for (std::istringstream in(p.options); in >> token;) {
+      if (std::find(macros.begin(), macros.end(), token.substr(std::min<size_t>(2, token.size()))) != macros.end())
+        features.insert(token);
+      else
+        rest += " " + token;
+    }
+    std::string key;
+    for (const std::string& f : p.files) key += f + ",";
+    return std::pair{key + rest, features};
+  };
+  std::map<std::string, std::set<std::set<std::string>>> every, ends;
+  for (const ProgramSpec& p : programVariants(FeatureSpan::EveryCombination)) {
+    const auto [key, features] = split(p);
+    every[key].insert(features);
+  }
+  for (const ProgramSpec& p : programVariants(FeatureSpan::NoneAndAll)) {
+    const auto [key, features] = split(p);
+    EXPECT_EQ(every.count(key) && every[key].count(features), 1u)
+        << p.name << " [" << p.options << "] is not among every combination's programs";
+    ends[key].insert(features);
+  }
+  size_t programs = 0, endPrograms = 0;
+  for (const auto& [key, sets] : every) {
+    std::set<std::string> most;
+    for (const auto& features : sets) most.insert(features.begin(), features.end());
+    EXPECT_EQ(ends[key].count(*sets.begin()), 1u) << key << ": the back ends build it without its fewest features";
+    EXPECT_EQ(ends[key].count(most), 1u) << key << ": the back ends build it without all of its features together";
+    programs += sets.size();
+    endPrograms += ends[key].size();
+  }
+  EXPECT_LT(endPrograms, programs / 2);
+}
+
 // With inlining left to the compiler and optimisation off, every helper must have a
 // definition of its own. OpenCL C follows C99, where a non-static `inline` function
 // provides none: the IR then declares it, and a device that does not inline fails to link.
@@ -100,8 +200,8 @@ INSTANTIATE_TEST_SUITE_P(Targets, OfflineCompile, ::testing::ValuesIn(kTargets),
 // so an unmangled declaration is one of fredholm's helpers left undefined.
 TEST(OfflineCompileWithoutInlining, NoHelperIsLeftUndefined) {
   ASSERT_TRUE(fs::exists(FREDHOLM_CLANG)) << "clang not found (" << FREDHOLM_CLANG << "): apt-get install clang";
-  const auto results = compileEveryVariant(
-      "noinline", std::string(kStrict) + " -O0 -DFH_NO_FORCED_INLINE -target spir64", "-emit-llvm -S");
+  const auto results = compileVariants(
+      FeatureSpan::EveryCombination, "noinline", std::string(kStrict) + " -O0 -DFH_NO_FORCED_INLINE -target spir64", "-emit-llvm -S");
   const std::regex declaration(R"(^declare [^@]*@([A-Za-z_][A-Za-z0-9_.]*)\()");
   for (const auto& r : results) {
     ASSERT_EQ(r.result.exitCode, 0) << r.program << ":\n" << r.result.output;
