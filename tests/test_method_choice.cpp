@@ -162,6 +162,27 @@ TEST(MethodChoiceCli, ARenderTooShortForPilotsIsMisWithoutThem) {
       << r.run.output;
 }
 
+// Where mis is the only method the settings allow (light paths take neither adaptive passes
+// nor first-surface layers), auto renders with it at once: nothing to time or pilot, however
+// long the render.
+TEST(MethodChoiceCli, WhereMisIsTheOnlyMethodNothingIsPiloted) {
+  for (const std::string flags : {"--adaptive", "--aovs albedo,normal"}) {
+    const AutoRender r = renderAuto(test::projectScene("failure/caustic.obj"), flags);
+    ASSERT_EQ(r.run.exitCode, 0) << flags << ": " << r.run.output;
+    const nlohmann::json& choice = r.stats["method_choice"];
+    EXPECT_EQ(choice["chosen"], "mis") << flags;
+    EXPECT_EQ(r.stats["method"], "mis") << flags;
+    EXPECT_EQ(choice["candidates"], nlohmann::json::array({"mis"})) << flags << ": " << choice.dump(2);
+    EXPECT_FALSE(choice["piloted"].get<bool>()) << flags;
+    EXPECT_TRUE(choice["methods"].empty()) << flags << ": " << choice.dump(2);
+    EXPECT_EQ(choice["render_seconds"].get<double>(), 0.0) << flags << ": mis was timed for nothing";
+    EXPECT_EQ(r.run.output.find("a pilot render with each of"), std::string::npos) << r.run.output;
+    EXPECT_NE(r.run.output.find("--method auto chose mis without pilots: the only method for these settings"),
+              std::string::npos)
+        << r.run.output;
+  }
+}
+
 // With a constant environment nothing starts at the lights alone: no lt pilot; bdpt's
 // camera subpaths find the environment.
 TEST(MethodChoiceCli, AnEnvironmentLeavesLightTracingOut) {

@@ -348,13 +348,19 @@ RenderResult renderOnEveryRank(const RenderOptions& o, const std::vector<DeviceI
 MethodChoice choosePilotedMethod(const std::vector<DeviceInfo>& devices, const Scene& scene, const Bvh& bvh,
                                  const Camera& camera, RenderSettings& settings, const RenderLinks& links) {
   std::string names;
-  for (Method m : methodsFor(scene, settings)) names += (names.empty() ? "" : ", ") + std::string(methodName(m));
-  std::cerr << "fredholm: --method auto: a pilot render with each of " << names << "\n";
+  const std::vector<Method> candidates = methodsFor(scene, settings);
+  for (Method m : candidates) names += (names.empty() ? "" : ", ") + std::string(methodName(m));
+  if (candidates.size() > 1) std::cerr << "fredholm: --method auto: a pilot render with each of " << names << "\n";
   const MethodChoice choice = chooseMethod(devices, scene, bvh, camera, settings, links.stop);
   if (links.stopRequested()) throw Interrupted("during --method auto's pilot renders; nothing written", links.stop->load());
   settings.method = choice.method;
   settings.fingerprint = renderFingerprint(scene, camera, settings);
   if (settings.seconds > 0) settings.seconds = std::max(settings.seconds - choice.seconds, 1e-6);
+  if (choice.alone()) {
+    std::cerr << "fredholm: --method auto chose mis without pilots: the only method for these settings (lt and "
+              << "bdpt do not go with " << (settings.adaptive ? "--adaptive" : "first-surface layers") << ")\n";
+    return choice;
+  }
   if (!choice.piloted()) {
     std::cerr << "fredholm: --method auto chose mis without pilots: the smallest would take about "
               << formatSeconds(choice.leastPilotSeconds) << " s of the render's " << formatSeconds(choice.renderSeconds)
@@ -373,7 +379,10 @@ nlohmann::json choiceJson(const MethodChoice& c) {
   for (const MethodTrial& t : c.trials)
     methods[methodName(t.method)] = {
         {"seconds", t.seconds}, {"relmse", t.relMse}, {"cost", t.cost()}, {"passes", t.passes}};
+  nlohmann::json candidates = nlohmann::json::array();
+  for (Method m : c.candidates) candidates.push_back(methodName(m));
   return {{"chosen", methodName(c.method)},
+          {"candidates", candidates},
           {"margin", kChoiceMargin},
           {"piloted", c.piloted()},
           {"render_seconds", c.renderSeconds},
@@ -515,7 +524,8 @@ int runRender(RenderOptions o) {
     metadata["method_choice"] = choice->piloted() ? "auto: relMSE x seconds of " + std::to_string(choice->pilotWidth) +
                                                         "x" + std::to_string(choice->pilotHeight) +
                                                         " pilots: " + choice->describeCosts()
-                                                  : "auto: mis without pilots (the render too short for them)";
+                                                  : choice->alone() ? "auto: mis, the only method for these settings"
+                                                                    : "auto: mis without pilots (the render too short for them)";
   const Image image = r.film.imageWithLayers(layers);
   const std::string passes = std::to_string(r.film.passes()) + " passes";
   // The files, and the live view's last frame: the image as written.

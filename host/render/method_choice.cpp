@@ -87,17 +87,21 @@ MethodChoice chooseMethod(const std::vector<DeviceInfo>& devices, const Scene& s
   MethodChoice choice;
   RenderLinks links;
   links.stop = stop;
-  const std::vector<Method> methods = methodsFor(scene, s);
-  // mis's samples per second, from a short render, and so the render's expected time and the
-  // pilots' samples.
-  const RenderSettings timing = pilotSettings(s, Method::MIS, kMaxPilotSide / 2, int(kNoiseMinPasses), 0.0);
-  const RenderResult timed = render(devices, scene, bvh, camera, timing, links);
-  const double perSecond = double(timed.stats.samples) / steadySeconds(timed.stats);
-  const double atMisSpeed = double(s.width) * s.height * s.spp / perSecond;
-  choice.renderSeconds = s.seconds > 0 ? std::min(s.seconds, atMisSpeed) : atMisSpeed;
-  // The smallest pilots at mis's steady speed: an estimate from below (slower methods take
-  // longer, and each pilot sets up), so that pilots are left out only where they cannot pay.
-  choice.leastPilotSeconds = double(methods.size()) * kLeastPilotSamples / perSecond;
+  choice.candidates = methodsFor(scene, s);
+  const std::vector<Method>& methods = choice.candidates;
+  double perSecond = 0.0;
+  if (!choice.alone()) {
+    // mis's samples per second, from a short render, and so the render's expected time and
+    // the pilots' samples.
+    const RenderSettings timing = pilotSettings(s, Method::MIS, kMaxPilotSide / 2, int(kNoiseMinPasses), 0.0);
+    const RenderResult timed = render(devices, scene, bvh, camera, timing, links);
+    perSecond = double(timed.stats.samples) / steadySeconds(timed.stats);
+    const double atMisSpeed = double(s.width) * s.height * s.spp / perSecond;
+    choice.renderSeconds = s.seconds > 0 ? std::min(s.seconds, atMisSpeed) : atMisSpeed;
+    // The smallest pilots at mis's steady speed: an estimate from below (slower methods take
+    // longer, and each pilot sets up), so that pilots are left out only where they cannot pay.
+    choice.leastPilotSeconds = double(methods.size()) * kLeastPilotSamples / perSecond;
+  }
   if (choice.piloted()) {
     choice.pilotSeconds = kPilotShare * choice.renderSeconds / double(methods.size());
     const int side = pilotSide(choice.pilotSeconds * perSecond, std::max(s.width, s.height));

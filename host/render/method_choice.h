@@ -50,13 +50,17 @@ struct MethodTrial {
 
 struct MethodChoice {
   Method method = Method::MIS;
+  // The methods that can render the scene with these settings (methodsFor). Where mis is the
+  // only one, nothing is timed or piloted.
+  std::vector<Method> candidates;
+  bool alone() const { return candidates.size() < 2; }
   int pilotWidth = 0, pilotHeight = 0;
   double pilotSeconds = 0.0;  // each method's pilot time budget
   double seconds = 0.0;       // the whole pilot, set-up included
   // The render's expected seconds at mis's speed, and what the smallest pilots would take of
   // them at that speed (more than kMostPilotShare: no pilots, `trials` empty).
   double renderSeconds = 0.0, leastPilotSeconds = 0.0;
-  bool piloted() const { return leastPilotSeconds <= kMostPilotShare * renderSeconds; }
+  bool piloted() const { return !alone() && leastPilotSeconds <= kMostPilotShare * renderSeconds; }
   std::vector<MethodTrial> trials;
   // "mis 8.4e-03 (90 spp), lt 5.5e-03 (41 spp), bdpt 4.6e-03 (16 spp)": each trial's cost
   // and passes.
