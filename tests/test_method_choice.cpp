@@ -6,9 +6,11 @@
 #include <gtest/gtest.h>
 #include <OpenImageIO/imageio.h>
 
+#include <random>
 #include <string>
 
 #include "cli/flags.h"
+#include "image/error_metrics.h"
 #include "image/image_io.h"
 #include "render/method_choice.h"
 #include "scene/environment_map.h"
@@ -32,6 +34,92 @@ TEST(MethodChoice, AnotherMethodMustBeatMisByTheMargin) {
   EXPECT_EQ(cheapestMethod({}), Method::MIS);                          // stopped before any pilot
   // The time counts as much as the error: half the error at three times the time loses.
   EXPECT_EQ(cheapestMethod({{Method::MIS, 1.0, 1.0}, {Method::LT, 3.0, 0.5}}), Method::MIS);
+}
+
+// A pilot image: `truth` with Gaussian noise of relative deviation `sigma`, from `seed`.
+Image noisy(const Image& truth, double sigma, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal;
+  Image p = truth;
+  for (float& v : p.rgb) v = float(v * (1.0 + sigma * normal(rng)));
+  return p;
+}
+
+// relMSE of `image` against the truth, as fredholm compare measures it.
+double relMseAgainst(const Image& image, const Image& truth) {
+  double total = 0.0;
+  for (size_t v = 0; v < truth.rgb.size(); ++v) {
+    const double d = double(image.rgb[v]) - truth.rgb[v];
+    total += d * d / (double(truth.rgb[v]) * truth.rgb[v] + kRelMseEpsilon);
+  }
+  return total / double(truth.rgb.size());
+}
+
+Image gradient(int side) {
+  Image truth;
+  truth.width = truth.height = side;
+  for (int p = 0; p < side * side; ++p)
+    for (int c = 0; c < 3; ++c) truth.rgb.push_back(0.2f + 0.8f * float(p % side) / float(side) + 0.1f * float(c));
+  return truth;
+}
+
+// Three pilots of known error: the pairs' differences give each one's error, whatever the
+// pilots claim; two pilots give each one's error once the other's is known.
+TEST(MethodChoice, PilotsJudgeEachOtherFromTheirDifferences) {
+  const Image truth = gradient(128);
+  const std::vector<Image> pilots = {noisy(truth, 0.1, 1), noisy(truth, 0.15, 2), noisy(truth, 0.3, 3)};
+  std::vector<double> actual;
+  for (const Image& p : pilots) actual.push_back(relMseAgainst(p, truth));
+  const std::vector<double> cross = crossRelMse(pilots, {0.0, 0.0, 0.0});  // three: own estimates unused
+  for (size_t i = 0; i < pilots.size(); ++i) EXPECT_NEAR(cross[i], actual[i], 0.1 * actual[i]) << i;
+  const std::vector<double> two = crossRelMse({pilots[0], pilots[2]}, {actual[0], actual[2]});
+  EXPECT_NEAR(two[0], actual[0], 0.1 * actual[0]);
+  EXPECT_NEAR(two[1], actual[2], 0.1 * actual[2]);
+  EXPECT_EQ(crossRelMse({pilots[0]}, {actual[0]}), std::vector<double>{0.0});  // nothing to compare with
+}
+
+// A heavy-tailed method's pilot that found none of its rare bright paths is smooth, and its
+// own halves agree: by its own estimate it wins. The other pilots have those paths, and judged
+// by them it is far off: mis stays. Where the others agree with the own estimates, the
+// choice is the own estimates'.
+TEST(MethodChoice, APilotMissingRarePathsIsJudgedByTheOthers) {
+  Image truth = gradient(96);
+  // A caustic: bright 4x4 spots, one in every 16x16 pixels.
+  const auto spot = [](size_t v) { return (v / 3) % 96 % 16 < 4 && (v / 3) / 96 % 16 < 4; };
+  for (size_t v = 0; v < truth.rgb.size(); ++v)
+    if (spot(v)) truth.rgb[v] = 40.0f;
+  Image blind = noisy(truth, 0.01, 4);
+  for (size_t v = 0; v < truth.rgb.size(); ++v)
+    if (spot(v)) blind.rgb[v] = 1.0f;  // never found
+  const std::vector<Image> images = {noisy(truth, 0.1, 5), blind, noisy(truth, 0.15, 6)};
+  std::vector<MethodTrial> pilots = {{Method::MIS, 1.0, relMseAgainst(images[0], truth)},
+                                     {Method::LT, 1.0, 1e-4},
+                                     {Method::BDPT, 1.0, relMseAgainst(images[2], truth)}};
+  EXPECT_EQ(cheapestMethod(pilots), Method::LT);  // by their own estimates
+  judgePilots(pilots, images);
+  EXPECT_GT(pilots[1].crossRelMse, 0.5 * relMseAgainst(blind, truth));
+  EXPECT_EQ(cheapestMethod(pilots), Method::MIS);
+  // A method that is better by both estimates is chosen: the same pilots, but lt's image
+  // found the spots too.
+  std::vector<Image> seeing = images;
+  seeing[1] = noisy(truth, 0.01, 4);
+  judgePilots(pilots, seeing);
+  EXPECT_LT(pilots[1].crossRelMse, 0.2 * pilots[0].crossRelMse);
+  EXPECT_EQ(cheapestMethod(pilots), Method::LT);
+}
+
+// Both estimates must clear the margin: a method ahead by its own estimate but level with mis
+// in the others' stays behind mis, and one ahead in the others' alone too.
+TEST(MethodChoice, AnotherMethodMustBeatMisInBothEstimates) {
+  std::vector<MethodTrial> t = {{Method::MIS, 1.0, 1.0, 64, 1.0}, {Method::BDPT, 1.0, 0.5, 64, 0.9}};
+  EXPECT_EQ(cheapestMethod(t), Method::MIS);
+  t[1].crossRelMse = 0.5;
+  EXPECT_EQ(cheapestMethod(t), Method::BDPT);
+  t[1].relMse = 0.9;
+  EXPECT_EQ(cheapestMethod(t), Method::MIS);
+  // Not judged (no other pilot to compare with): the own estimates decide.
+  t = {{Method::MIS, 1.0, 1.0}, {Method::BDPT, 1.0, 0.5}};
+  EXPECT_EQ(cheapestMethod(t), Method::BDPT);
 }
 
 // mis's pilot samples go to the image's size, at kMinPilotSpp passes, up to the largest side.
@@ -121,7 +209,8 @@ void expectChoice(const AutoRender& r, const std::string& method, size_t methods
     EXPECT_GE(double(passes) * choice["pilot_width"].get<int>() * choice["pilot_height"].get<int>(),
               double(kMinPilotSide) * kMinPilotSide * kMinPilotSpp)
         << name;
-    pilots.push_back({parseMethod(name), trial["seconds"], trial["relmse"]});
+    EXPECT_GT(trial["cross_relmse"].get<double>(), 0.0) << name;  // judged by the others
+    pilots.push_back({parseMethod(name), trial["seconds"], trial["relmse"], passes, trial["cross_relmse"]});
   }
   EXPECT_EQ(methodName(cheapestMethod(pilots)), method);
   EXPECT_NE(r.run.output.find("--method auto chose " + method + " ("), std::string::npos) << r.run.output;

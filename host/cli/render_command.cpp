@@ -367,8 +367,8 @@ MethodChoice choosePilotedMethod(const std::vector<DeviceInfo>& devices, const S
               << " s, more than a fifth\n";
     return choice;
   }
-  std::cerr << "fredholm: --method auto chose " << methodName(choice.method) << " (relMSE x seconds of "
-            << choice.pilotWidth << "x" << choice.pilotHeight << " pilots of " << formatSeconds(choice.pilotSeconds)
+  std::cerr << "fredholm: --method auto chose " << methodName(choice.method) << " (relMSE x seconds, by its own and by the "
+            << "other pilots' estimates, of " << choice.pilotWidth << "x" << choice.pilotHeight << " pilots of " << formatSeconds(choice.pilotSeconds)
             << " s each: " << choice.describeCosts() << "; pilots took " << formatSeconds(choice.seconds) << " s)\n";
   return choice;
 }
@@ -378,7 +378,8 @@ nlohmann::json choiceJson(const MethodChoice& c) {
   nlohmann::json methods = nlohmann::json::object();
   for (const MethodTrial& t : c.trials)
     methods[methodName(t.method)] = {
-        {"seconds", t.seconds}, {"relmse", t.relMse}, {"cost", t.cost()}, {"passes", t.passes}};
+        {"seconds", t.seconds},          {"relmse", t.relMse},     {"cost", t.cost()},
+        {"cross_relmse", t.crossRelMse}, {"cross_cost", t.crossCost()}, {"passes", t.passes}};
   nlohmann::json candidates = nlohmann::json::array();
   for (Method m : c.candidates) candidates.push_back(methodName(m));
   return {{"chosen", methodName(c.method)},
@@ -521,7 +522,7 @@ int runRender(RenderOptions o) {
   std::map<std::string, std::string> metadata = imageMetadata(o, scene, r, method, spp, seconds, estimatedRelMse);
   if (settings.adaptive) metadata["adaptive"] = "1";
   if (choice)
-    metadata["method_choice"] = choice->piloted() ? "auto: relMSE x seconds of " + std::to_string(choice->pilotWidth) +
+    metadata["method_choice"] = choice->piloted() ? "auto: relMSE x seconds (own / the others' estimate) of " + std::to_string(choice->pilotWidth) +
                                                         "x" + std::to_string(choice->pilotHeight) +
                                                         " pilots: " + choice->describeCosts()
                                                   : choice->alone() ? "auto: mis, the only method for these settings"

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "base/error.h"
+#include "image/error_metrics.h"
 #include "render/render.h"
 
 namespace fh {
@@ -14,8 +16,8 @@ namespace fh {
 std::string MethodChoice::describeCosts() const {
   std::string text;
   for (const MethodTrial& t : trials) {
-    char cost[32];
-    std::snprintf(cost, sizeof cost, "%.2e (%u spp)", t.cost(), t.passes);
+    char cost[48];
+    std::snprintf(cost, sizeof cost, "%.2e / %.2e (%u spp)", t.cost(), t.crossCost(), t.passes);
     text += (text.empty() ? "" : ", ") + std::string(methodName(t.method)) + " " + cost;
   }
   return text;
@@ -35,10 +37,86 @@ std::vector<Method> methodsFor(const Scene& scene, const RenderSettings& s) {
 Method cheapestMethod(const std::vector<MethodTrial>& trials) {
   const auto mis = std::find_if(trials.begin(), trials.end(), [](const MethodTrial& t) { return t.method == Method::MIS; });
   if (mis == trials.end()) return Method::MIS;
+  const bool judged = std::any_of(trials.begin(), trials.end(), [](const MethodTrial& t) { return t.crossRelMse > 0; });
   const MethodTrial* best = &*mis;
   for (const MethodTrial& t : trials)
-    if (t.cost() < best->cost()) best = &t;
+    if (t.cost() < best->cost() && (!judged || t.crossCost() < kChoiceMargin * mis->crossCost())) best = &t;
   return best->cost() < kChoiceMargin * mis->cost() ? best->method : Method::MIS;
+}
+
+namespace {
+
+// The pilots' mean image, each value averaged over its pixel's 3x3 neighbourhood (as much of
+// it as lies in the image), per channel.
+std::vector<double> neighbourhoodMean(const std::vector<Image>& pilots) {
+  const int w = pilots[0].width, h = pilots[0].height;
+  std::vector<double> mean(pilots[0].rgb.size(), 0.0);
+  for (const Image& p : pilots)
+    for (size_t v = 0; v < mean.size(); ++v) mean[v] += double(p.rgb[v]) / double(pilots.size());
+  if (size_t(w) * size_t(h) * 3 != mean.size()) return mean;  // no layout to average over
+  std::vector<double> level(mean.size(), 0.0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        double sum = 0.0;
+        int count = 0;
+        for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, h - 1); ++ny)
+          for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, w - 1); ++nx, ++count)
+            sum += mean[3 * (size_t(ny) * size_t(w) + size_t(nx)) + size_t(c)];
+        level[3 * (size_t(y) * size_t(w) + size_t(x)) + size_t(c)] = sum / count;
+      }
+  return level;
+}
+
+}  // namespace
+
+std::vector<double> crossRelMse(const std::vector<Image>& pilots, const std::vector<double>& own) {
+  const size_t n = pilots.size();
+  std::vector<double> cross(n, 0.0);
+  if (n < 2) return cross;
+  const size_t values = pilots[0].rgb.size();
+  for (const Image& p : pilots)
+    if (p.rgb.size() != values) throw Error("method choice: pilot images of different sizes");
+  // d[i][j]: the mean squared difference of pilots i and j, relative to their mean image
+  // averaged over each pixel's 3x3 neighbourhood: a pixel's own noise in the divisor would
+  // raise every d (the mean of 1 / x^2 exceeds 1 / mean^2).
+  const std::vector<double> level = neighbourhoodMean(pilots);
+  std::vector<std::vector<double>> d(n, std::vector<double>(n, 0.0));
+  for (size_t v = 0; v < values; ++v) {
+    const double scale = 1.0 / (level[v] * level[v] + kRelMseEpsilon);
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j = i + 1; j < n; ++j) {
+        const double diff = double(pilots[i].rgb[v]) - double(pilots[j].rgb[v]);
+        d[i][j] += diff * diff * scale;
+      }
+  }
+  double total = 0.0;  // the sum over pairs
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = i + 1; j < n; ++j) {
+      d[i][j] /= double(std::max<size_t>(values, 1));
+      d[j][i] = d[i][j];
+      total += d[i][j];
+    }
+  for (size_t i = 0; i < n; ++i) {
+    if (n == 2) {
+      cross[i] = d[0][1] - own[1 - i];
+    } else {
+      // Least squares of d_ij = e_i + e_j over the pairs: with S_i the sum of i's pairs and
+      // T that of all, e_i = (S_i - T / (n - 1)) / (n - 2).
+      double pairs = 0.0;
+      for (size_t j = 0; j < n; ++j) pairs += d[i][j];
+      cross[i] = (pairs - total / double(n - 1)) / double(n - 2);
+    }
+    cross[i] = std::max(cross[i], 0.0);
+  }
+  return cross;
+}
+
+void judgePilots(std::vector<MethodTrial>& trials, const std::vector<Image>& images) {
+  std::vector<double> own;
+  for (const MethodTrial& t : trials) own.push_back(t.relMse);
+  const std::vector<double> cross = crossRelMse(images, own);
+  for (size_t i = 0; i < trials.size(); ++i) trials[i].crossRelMse = cross[i];
 }
 
 int pilotSide(double samples, int imageSide) {
@@ -105,15 +183,21 @@ MethodChoice chooseMethod(const std::vector<DeviceInfo>& devices, const Scene& s
   if (choice.piloted()) {
     choice.pilotSeconds = kPilotShare * choice.renderSeconds / double(methods.size());
     const int side = pilotSide(choice.pilotSeconds * perSecond, std::max(s.width, s.height));
+    std::vector<Image> images;
     for (Method method : methods) {
       if (links.stopRequested()) break;
-      const RenderSettings p = pilotSettings(s, method, side, kMaxPilotSpp, choice.pilotSeconds);
+      RenderSettings p = pilotSettings(s, method, side, kMaxPilotSpp, choice.pilotSeconds);
+      // A seed of its own: the pilots' errors independent, as judgePilots needs (mis's and
+      // bdpt's camera paths would otherwise draw the same numbers).
+      p.seed = s.seed + 1u + unsigned(images.size());
       choice.pilotWidth = p.width;
       choice.pilotHeight = p.height;
       const RenderResult r = render(devices, scene, bvh, camera, p, links);
       if (r.stopped || !r.complete) break;
       choice.trials.push_back({method, steadySeconds(r.stats), r.film.estimatedRelMse(), unsigned(r.film.passes())});
+      images.push_back(r.film.image());
     }
+    if (choice.trials.size() == methods.size()) judgePilots(choice.trials, images);
   }
   choice.method = cheapestMethod(choice.trials);  // mis where no pilot ran
   choice.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

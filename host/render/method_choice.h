@@ -11,6 +11,7 @@
 
 #include "accel/bvh.h"
 #include "device/devices.h"
+#include "image/image_io.h"
 #include "render/settings.h"
 #include "scene/camera.h"
 #include "scene/scene.h"
@@ -43,9 +44,11 @@ constexpr double kMostPilotShare = 0.2;
 struct MethodTrial {
   Method method = Method::MIS;
   double seconds = 0.0;  // the pilot's render time (set-up and compiling excluded)
-  double relMse = 0.0;   // the pilot image's estimated relMSE
+  double relMse = 0.0;   // the pilot image's relMSE, estimated from its own two replicates
   unsigned passes = 0;   // the pilot's passes (samples per pixel)
+  double crossRelMse = 0.0;  // the same as the other pilots see it (judgePilots; 0: not judged)
   double cost() const { return relMse * seconds; }
+  double crossCost() const { return crossRelMse * seconds; }
 };
 
 struct MethodChoice {
@@ -62,8 +65,8 @@ struct MethodChoice {
   double renderSeconds = 0.0, leastPilotSeconds = 0.0;
   bool piloted() const { return !alone() && leastPilotSeconds <= kMostPilotShare * renderSeconds; }
   std::vector<MethodTrial> trials;
-  // "mis 8.4e-03 (90 spp), lt 5.5e-03 (41 spp), bdpt 4.6e-03 (16 spp)": each trial's cost
-  // and passes.
+  // "mis 8.4e-03 / 9.0e-03 (90 spp), lt 5.5e-03 / 6.1e-03 (41 spp), ...": each trial's cost
+  // by its own estimate and by the other pilots', and its passes.
   std::string describeCosts() const;
 };
 
@@ -78,8 +81,26 @@ struct MethodChoice {
 std::vector<Method> methodsFor(const Scene& scene, const RenderSettings& s);
 
 // Of the trials, the method the render should use: the cheapest where it beats mis's cost by
-// kChoiceMargin, else mis.
+// kChoiceMargin, and where the trials were judged by each other (crossRelMse), beats mis's
+// cost by the margin in that judgement too; else mis. The two estimates fail apart: a pilot's
+// own misses what neither of its halves found, and on a pilot image whose lights are a pixel
+// wide it runs high for every method alike, where the others' still ranks them.
 Method cheapestMethod(const std::vector<MethodTrial>& trials);
+
+// Each pilot's relMSE as the other pilots see it. The pilots are independent unbiased
+// renders of one image (each with a seed of its own), so the mean squared relative
+// difference of two, d_ij, is about e_i + e_j, the sum of their errors; from three or more,
+// each e_i follows from the pairs by least squares (for three, (d_ij + d_ik - d_jk) / 2: the
+// "three-cornered hat" of clock comparisons, Grubbs 1948), and from two, what d leaves once
+// the other's own estimate is taken off. A pilot's own estimate, from its two halves, cannot
+// see what neither half found: a heavy-tailed method's rare bright paths, missing from its
+// image, are in the others'. Differences are relative to the pilots' mean image averaged
+// over 3x3 pixels, with relMSE's epsilon. `own`: each pilot's own estimate; images of one
+// size.
+std::vector<double> crossRelMse(const std::vector<Image>& pilots, const std::vector<double>& own);
+
+// Sets each trial's crossRelMse from the pilots' images, in the trials' order.
+void judgePilots(std::vector<MethodTrial>& trials, const std::vector<Image>& images);
 
 // The pilot's longer side for `samples` of mis's samples per method: the side at which they
 // make kMinPilotSpp passes, within the bounds above and no larger than the image's. (The
