@@ -65,7 +65,8 @@ std::vector<ProgramSpec> programVariants(FeatureSpan span) {
   // material feature, and lt's camera paths (mis keeping those that leave the first vertex by
   // a delta lobe) with glass and mirrors.
   for (Method method : {Method::LT, Method::BDPT})
-    for (const SceneFeatures& features : materialSets) programs.push_back(lightTracerProgram(method, features, traversal));
+    for (const SceneFeatures& features : materialSets)
+      programs.push_back(lightTracerProgram(method, features, traversal));
   // bdpt's light subpaths from the environment map too.
   programs.push_back(lightTracerProgram(Method::BDPT, SceneFeatures::all(), traversal));
   for (Strategy strategy : {Strategy::Scalar, Strategy::Simd8, Strategy::Megakernel8})

@@ -200,8 +200,9 @@ TEST(FeatureSwitches, BackEndsBuildEachProgramWithNoneAndAll) {
 // so an unmangled declaration is one of fredholm's helpers left undefined.
 TEST(OfflineCompileWithoutInlining, NoHelperIsLeftUndefined) {
   ASSERT_TRUE(fs::exists(FREDHOLM_CLANG)) << "clang not found (" << FREDHOLM_CLANG << "): apt-get install clang";
-  const auto results = compileVariants(
-      FeatureSpan::EveryCombination, "noinline", std::string(kStrict) + " -O0 -DFH_NO_FORCED_INLINE -target spir64", "-emit-llvm -S");
+  const auto results = compileVariants(FeatureSpan::EveryCombination, "noinline",
+                                       std::string(kStrict) + " -O0 -DFH_NO_FORCED_INLINE -target spir64",
+                                       "-emit-llvm -S");
   const std::regex declaration(R"(^declare [^@]*@([A-Za-z_][A-Za-z0-9_.]*)\()");
   for (const auto& r : results) {
     ASSERT_EQ(r.result.exitCode, 0) << r.program << ":\n" << r.result.output;

@@ -347,10 +347,11 @@ RenderResult renderOnEveryRank(const RenderOptions& o, const std::vector<DeviceI
 // whole render's: what the pilots took comes off it (at least a pass is rendered).
 MethodChoice choosePilotedMethod(const std::vector<DeviceInfo>& devices, const Scene& scene, const Bvh& bvh,
                                  const Camera& camera, RenderSettings& settings, const RenderLinks& links) {
-  std::string names;
-  const std::vector<Method> candidates = methodsFor(scene, settings);
-  for (Method m : candidates) names += (names.empty() ? "" : ", ") + std::string(methodName(m));
-  if (candidates.size() > 1) std::cerr << "fredholm: --method auto: a pilot render with each of " << names << "\n";
+  if (const std::vector<Method> candidates = methodsFor(scene, settings); candidates.size() > 1) {
+    std::string names;
+    for (Method m : candidates) names += (names.empty() ? "" : ", ") + std::string(methodName(m));
+    std::cerr << "fredholm: --method auto: a pilot render with each of " << names << "\n";
+  }
   const MethodChoice choice = chooseMethod(devices, scene, bvh, camera, settings, links.stop);
   if (links.stopRequested()) throw Interrupted("during --method auto's pilot renders; nothing written", links.stop->load());
   settings.method = choice.method;
@@ -367,10 +368,19 @@ MethodChoice choosePilotedMethod(const std::vector<DeviceInfo>& devices, const S
               << " s, more than a fifth\n";
     return choice;
   }
-  std::cerr << "fredholm: --method auto chose " << methodName(choice.method) << " (relMSE x seconds, by its own and by the "
-            << "other pilots' estimates, of " << choice.pilotWidth << "x" << choice.pilotHeight << " pilots of " << formatSeconds(choice.pilotSeconds)
+  std::cerr << "fredholm: --method auto chose " << methodName(choice.method)
+            << " (relMSE x seconds, by its own and by the other pilots' estimates, of " << choice.pilotWidth << "x"
+            << choice.pilotHeight << " pilots of " << formatSeconds(choice.pilotSeconds)
             << " s each: " << choice.describeCosts() << "; pilots took " << formatSeconds(choice.seconds) << " s)\n";
   return choice;
+}
+
+// What --method auto chose, as the image's metadata says it.
+std::string choiceMetadata(const MethodChoice& c) {
+  if (c.alone()) return "auto: mis, the only method for these settings";
+  if (!c.piloted()) return "auto: mis without pilots (the render too short for them)";
+  return "auto: relMSE x seconds (own / the others' estimate) of " + std::to_string(c.pilotWidth) + "x" +
+         std::to_string(c.pilotHeight) + " pilots: " + c.describeCosts();
 }
 
 // The choice and its figures, for --stats.
@@ -521,12 +531,7 @@ int runRender(RenderOptions o) {
   const double estimatedRelMse = debugView ? 0.0 : r.film.estimatedRelMse();
   std::map<std::string, std::string> metadata = imageMetadata(o, scene, r, method, spp, seconds, estimatedRelMse);
   if (settings.adaptive) metadata["adaptive"] = "1";
-  if (choice)
-    metadata["method_choice"] = choice->piloted() ? "auto: relMSE x seconds (own / the others' estimate) of " + std::to_string(choice->pilotWidth) +
-                                                        "x" + std::to_string(choice->pilotHeight) +
-                                                        " pilots: " + choice->describeCosts()
-                                                  : choice->alone() ? "auto: mis, the only method for these settings"
-                                                                    : "auto: mis without pilots (the render too short for them)";
+  if (choice) metadata["method_choice"] = choiceMetadata(*choice);
   const Image image = r.film.imageWithLayers(layers);
   const std::string passes = std::to_string(r.film.passes()) + " passes";
   // The files, and the live view's last frame: the image as written.

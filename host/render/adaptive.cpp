@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "image/error_metrics.h"
+#include "image/neighbourhood.h"
 
 namespace fh {
 namespace {
@@ -35,31 +36,7 @@ std::vector<double> errorFallPerSample(const Film& film, const std::vector<doubl
 // beside a noisy block is sampled with it. (5x5 blocks ranked worse where the noise is
 // fine-grained, as on the Veach plates: bench/RESULTS.md.)
 std::vector<double> smoothed(const std::vector<double>& v, int width, int height) {
-  const auto at = [width](int x, int y) { return size_t(y) * size_t(width) + size_t(x); };
-  // Along x, then along y: the mean (or the largest) of the pixels within `radius`, clipped
-  // at the edges.
-  const auto pass = [&](const std::vector<double>& in, int radius, bool mean) {
-    std::vector<double> across(in.size()), out(in.size());
-    for (int dir = 0; dir < 2; ++dir) {
-      const std::vector<double>& from = dir == 0 ? in : across;
-      std::vector<double>& to = dir == 0 ? across : out;
-      for (int y = 0; y < height; ++y)
-        for (int x = 0; x < width; ++x) {
-          double total = 0.0, most = 0.0;
-          int n = 0;
-          for (int d = -radius; d <= radius; ++d) {
-            const int nx = dir == 0 ? x + d : x, ny = dir == 0 ? y : y + d;
-            if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-            total += from[at(nx, ny)];
-            most = std::max(most, from[at(nx, ny)]);
-            ++n;
-          }
-          to[at(x, y)] = mean ? total / n : most;
-        }
-    }
-    return out;
-  };
-  return pass(pass(v, 1, true), 1, false);
+  return neighbourhoodMax(neighbourhoodMean(v, width, height, 1), width, height, 1);
 }
 
 // The value `share` of the way up the sorted values (0.999: all but the top thousandth).

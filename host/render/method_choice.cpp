@@ -9,6 +9,7 @@
 
 #include "base/error.h"
 #include "image/error_metrics.h"
+#include "image/neighbourhood.h"
 #include "render/render.h"
 
 namespace fh {
@@ -44,43 +45,21 @@ Method cheapestMethod(const std::vector<MethodTrial>& trials) {
   return best->cost() < kChoiceMargin * mis->cost() ? best->method : Method::MIS;
 }
 
-namespace {
-
-// The pilots' mean image, each value averaged over its pixel's 3x3 neighbourhood (as much of
-// it as lies in the image), per channel.
-std::vector<double> neighbourhoodMean(const std::vector<Image>& pilots) {
-  const int w = pilots[0].width, h = pilots[0].height;
-  std::vector<double> mean(pilots[0].rgb.size(), 0.0);
-  for (const Image& p : pilots)
-    for (size_t v = 0; v < mean.size(); ++v) mean[v] += double(p.rgb[v]) / double(pilots.size());
-  if (size_t(w) * size_t(h) * 3 != mean.size()) return mean;  // no layout to average over
-  std::vector<double> level(mean.size(), 0.0);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < 3; ++c) {
-        double sum = 0.0;
-        int count = 0;
-        for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, h - 1); ++ny)
-          for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, w - 1); ++nx, ++count)
-            sum += mean[3 * (size_t(ny) * size_t(w) + size_t(nx)) + size_t(c)];
-        level[3 * (size_t(y) * size_t(w) + size_t(x)) + size_t(c)] = sum / count;
-      }
-  return level;
-}
-
-}  // namespace
-
 std::vector<double> crossRelMse(const std::vector<Image>& pilots, const std::vector<double>& own) {
   const size_t n = pilots.size();
   std::vector<double> cross(n, 0.0);
   if (n < 2) return cross;
   const size_t values = pilots[0].rgb.size();
   for (const Image& p : pilots)
-    if (p.rgb.size() != values) throw Error("method choice: pilot images of different sizes");
+    if (p.width != pilots[0].width || p.height != pilots[0].height || p.rgb.size() != 3 * size_t(p.width) * p.height)
+      throw Error("method choice: pilot images of different sizes");
   // d[i][j]: the mean squared difference of pilots i and j, relative to their mean image
   // averaged over each pixel's 3x3 neighbourhood: a pixel's own noise in the divisor would
   // raise every d (the mean of 1 / x^2 exceeds 1 / mean^2).
-  const std::vector<double> level = neighbourhoodMean(pilots);
+  std::vector<double> mean(values, 0.0);
+  for (const Image& p : pilots)
+    for (size_t v = 0; v < values; ++v) mean[v] += double(p.rgb[v]) / double(n);
+  const std::vector<double> level = neighbourhoodMean(mean, pilots[0].width, pilots[0].height, 1, 3);
   std::vector<std::vector<double>> d(n, std::vector<double>(n, 0.0));
   for (size_t v = 0; v < values; ++v) {
     const double scale = 1.0 / (level[v] * level[v] + kRelMseEpsilon);
