@@ -26,6 +26,17 @@
 // Light vertices wait in `stored`, FH_BDPT_VERTEX_WORDS float4s each, max_depth per path: a
 // launch covers `count` paths from `first`, as many as the buffer holds.
 //
+// --method vcm (FH_VCM) adds vertex merging (Georgiev et al. 2012, "Light transport simulation
+// with vertex connection and merging"; Hachisuka et al. 2012): a launch's light subpaths are
+// traced first (vcm_light_subpaths), the host files their vertices in a hash grid of cells
+// 2r wide (render/merge_grid.h), and each camera vertex (vcm_camera_subpaths) also takes every
+// light vertex within r as if the two were one, a density estimate over the launch's N light
+// paths: the one strategy that samples a diffuse vertex seen and lit through delta lobes
+// (L S D S E, a caustic seen through glass). Merging is a strategy among the others in the
+// power heuristic, its density that of the light subpath times eta = N pi r^2; r shrinks
+// with the pass (render/merge_grid.h), so the estimate's bias goes to zero as passes grow.
+// `factors` carries mis2(eta) and mis2(1 / eta), both zero under plain bdpt.
+//
 // The environment map is a light like the triangles (picked with params.env_pick): its light
 // subpaths start on a disk as wide as the scene's bounding sphere (`sphere`: centre, radius),
 // facing a direction drawn from the map, beyond the sphere (Georgiev's background light), so
@@ -41,8 +52,15 @@
 #include "environment.h"
 #endif
 
-// A stored light vertex: (triangle bits, b1, b2, d_vcm), (w_in, d_vc), (alpha, scatterings).
-#define FH_BDPT_VERTEX_WORDS 3
+// A stored light vertex: (triangle bits, b1, b2, d_vcm), (w_in, d_vc), (alpha, scatterings),
+// (position, d_vm).
+#define FH_BDPT_VERTEX_WORDS 4
+
+// What merging adds to every strategy's weight: mis2(eta) and mis2(1 / eta) for the merging
+// radius's eta = N pi r^2 (zero under plain bdpt, which leaves the weights as they were).
+typedef struct {
+  float vm, vc;
+} MergeFactors;
 
 // The power heuristic's weight of a density ratio.
 FH_INLINE float mis2(float x) { return x * x; }
@@ -53,7 +71,9 @@ FH_INLINE float mis2(float x) { return x * x; }
 // the nearest below it that such a path has; the camera's alone for a directly seen emitter)
 // and none for the others, so that each strategy can be tested alone.
 FH_INLINE float strategy_weight(float power_heuristic, uint s, uint m) {
-#if defined(FH_BDPT_ONLY_S)
+#if defined(FH_VCM_MERGE_ONLY)
+  return s == 0u && m == 0u ? 1.0f : 0.0f;
+#elif defined(FH_BDPT_ONLY_S)
   const uint kept = m == 0u ? 0u : min(FH_BDPT_ONLY_S, m + 1u);
   return s == kept ? 1.0f : 0.0f;
 #else
@@ -63,20 +83,24 @@ FH_INLINE float strategy_weight(float power_heuristic, uint s, uint m) {
 
 // The recursive weights' state after a hit at distance d under |cos| = cos_g (the geometric
 // normal and the arriving direction): the densities of the new vertex in area measure.
-FH_INLINE void weights_at_hit(float* d_vcm, float* d_vc, float d, float cos_g) {
+FH_INLINE void weights_at_hit(float* d_vcm, float* d_vc, float* d_vm, float d, float cos_g) {
   *d_vcm *= mis2(d * d) / mis2(cos_g);
   *d_vc /= mis2(cos_g);
+  *d_vm /= mis2(cos_g);
 }
 
 // ... and after a BSDF sample from there (pdf < 0: a delta lobe, whose choice is as likely
 // both ways and whose vertex no connection can use): cos_out at the vertex toward the new
 // direction, pdf_rev the density of sampling the way back.
-FH_INLINE void weights_at_sample(float* d_vcm, float* d_vc, float pdf, float pdf_rev, float cos_out) {
+FH_INLINE void weights_at_sample(float* d_vcm, float* d_vc, float* d_vm, MergeFactors m, float pdf, float pdf_rev,
+                                  float cos_out) {
   if (pdf < 0.0f) {
     *d_vcm = 0.0f;
     *d_vc *= mis2(cos_out);
+    *d_vm *= mis2(cos_out);
   } else {
-    *d_vc = mis2(cos_out / pdf) * (*d_vc * mis2(pdf_rev) + *d_vcm);
+    *d_vc = mis2(cos_out / pdf) * (*d_vc * mis2(pdf_rev) + *d_vcm + m.vm);
+    *d_vm = mis2(cos_out / pdf) * (*d_vm * mis2(pdf_rev) + *d_vcm * m.vc + 1.0f);
     *d_vcm = mis2(1.0f / pdf);
   }
 }
@@ -88,15 +112,15 @@ FH_INLINE void weights_at_sample(float* d_vcm, float* d_vc, float pdf, float pdf
 // density), the weights' state, and whether it comes from infinitely far (the map).
 typedef struct {
   lvec3 org, dir, alpha;
-  float d_vcm, d_vc;
+  float d_vcm, d_vc, d_vm;
   int valid, infinite;
 } LightStart;
 
 // A point uniform in the area of a light triangle, leaving its front cosine-distributed:
 // Le cos / (p_A cos / pi), the emission density p_A cos / pi against light sampling's p_A
 // (d_vcm) and against the camera hitting the light (d_vc).
-FH_INLINE LightStart start_on_triangle(RenderParams params, const SceneView* scene, float u_pick, float u1, float u2,
-                                       float u3, float u4) {
+FH_INLINE LightStart start_on_triangle(RenderParams params, const SceneView* scene, MergeFactors m, float u_pick,
+                                       float u1, float u2, float u3, float u4) {
   const int light = scene->light_triangle[pick_light(scene->light_cdf, params.light_count, u_pick)];
   const lvec2 b = sample_triangle(u1, u2);
   const SurfacePoint y = surface_point(scene->triangles, light, b.x, b.y);
@@ -108,6 +132,7 @@ FH_INLINE LightStart start_on_triangle(RenderParams params, const SceneView* sce
   l.alpha = v3_scale(material_lanes(scene->materials, scene->triangle_material[light]).ke, M_PI_F / pdf_area);
   l.d_vcm = mis2(M_PI_F / cos_light);
   l.d_vc = mis2(M_PI_F / pdf_area);
+  l.d_vm = l.d_vc * m.vc;
   l.org = offset_ray_origin(&y, l.dir);
   l.infinite = 0;
   return l;
@@ -118,8 +143,8 @@ FH_INLINE LightStart start_on_triangle(RenderParams params, const SceneView* sce
 // the disk of the scene's bounding sphere that faces it, beyond the sphere, the ray toward
 // -w: Le / (p_w / (pi R^2)); light sampling's density p_w against the emission density (d_vcm)
 // and no cosine at the light (d_vc).
-FH_INLINE LightStart start_from_environment(RenderParams params, const SceneView* scene, float4 sphere, float u1,
-                                            float u2, float u3, float u4) {
+FH_INLINE LightStart start_from_environment(RenderParams params, const SceneView* scene, MergeFactors m, float4 sphere,
+                                            float u1, float u2, float u3, float u4) {
   const EnvironmentSample e = environment_sample(params, scene->env_map, u1, u2);
   const float pdf_w = params.env_pick * e.pdf, disk_area = M_PI_F * sphere.w * sphere.w;
   lvec3 t, b;
@@ -133,13 +158,14 @@ FH_INLINE LightStart start_from_environment(RenderParams params, const SceneView
   l.alpha = v3_scale(e.radiance, disk_area / pdf_w);
   l.d_vcm = mis2(disk_area);
   l.d_vc = mis2(disk_area / pdf_w);
+  l.d_vm = l.d_vc * m.vc;
   l.infinite = 1;
   return l;
 }
 #endif
 
-FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, float4 sphere, uint stream,
-                                   uint path, __global float4* stored, volatile __global uint* splats,
+FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, MergeFactors m, float4 sphere,
+                                   uint stream, uint path, __global float4* stored, volatile __global uint* splats,
                                    __global const float* density, LightTally* tally) {
   uint dim = 0u, count = 0u;
   const float u_pick = random_float(stream, path, dim++);
@@ -149,13 +175,13 @@ FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, 
   start.valid = 0;
   (void)sphere;  // read with FH_ENV_MAP only
 #if defined(FH_ENV_MAP)
-  if (u_pick < params.env_pick) start = start_from_environment(params, scene, sphere, u1, u2, u3, u4);
+  if (u_pick < params.env_pick) start = start_from_environment(params, scene, m, sphere, u1, u2, u3, u4);
   else
 #endif
-  if (params.light_count > 0u) start = start_on_triangle(params, scene, u_pick, u1, u2, u3, u4);
+  if (params.light_count > 0u) start = start_on_triangle(params, scene, m, u_pick, u1, u2, u3, u4);
   if (!start.valid) return 0u;
   lvec3 alpha = start.alpha, dir = start.dir, org = start.org;
-  float d_vcm = start.d_vcm, d_vc = start.d_vc;
+  float d_vcm = start.d_vcm, d_vc = start.d_vc, d_vm = start.d_vm;
   lvec3 carried = v3_splat(1.0f);
 
   for (uint scatterings = 1u; scatterings <= params.max_depth; ++scatterings) {
@@ -168,7 +194,7 @@ FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, 
     const float cos_g_in = v3_dot(v.point.normal, w_in);
     if (cos_g_in == 0.0f) break;
     // From the map, the first hit is at no distance the light's density knows of.
-    weights_at_hit(&d_vcm, &d_vc, start.infinite && scatterings == 1u ? 1.0f : hit.t, fabs(cos_g_in));
+    weights_at_hit(&d_vcm, &d_vc, &d_vm, start.infinite && scatterings == 1u ? 1.0f : hit.t, fabs(cos_g_in));
     const lvec3 g = cos_g_in > 0.0f ? v.point.normal : v3_neg(v.point.normal);
     const lvec3 n = cos_g_in > 0.0f ? v.shading_normal : v3_neg(v.shading_normal);
 
@@ -177,6 +203,7 @@ FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, 
       s[0] = (float4)(as_float(hit.triangle), hit.b1, hit.b2, d_vcm);
       s[1] = (float4)(w_in.x, w_in.y, w_in.z, d_vc);
       s[2] = (float4)(alpha.x, alpha.y, alpha.z, (float)scatterings);
+      s[3] = (float4)(v.point.position.x, v.point.position.y, v.point.position.z, d_vm);
       // t = 1: the pinhole, weighed against the camera finding this vertex (the film's
       // density of it, in area) and everything further from the camera.
       const CameraView view = camera_view(params, &v.point);
@@ -184,7 +211,7 @@ FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, 
       if (view.seen && cos_camera > 0.0f) {
         const lvec3 f = bsdf_eval(&v.bsdf, n, view.to_camera, w_in);
         const float pdf_rev = bsdf_pdf(&v.bsdf, n, view.to_camera, w_in);
-        const float w_light = mis2(view.importance * cos_camera) * (d_vcm + d_vc * mis2(pdf_rev));
+        const float w_light = mis2(view.importance * cos_camera) * (m.vm + d_vcm + d_vc * mis2(pdf_rev));
         const float weight = strategy_weight(1.0f / (1.0f + w_light), scatterings + 1u, scatterings);
         connect_to_camera(params, scene, &view,
                           v3_scale(v3_mul(alpha, f), fabs(v3_dot(n, w_in)) * cos_camera / fabs(cos_g_in) * weight),
@@ -196,7 +223,7 @@ FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, 
     const BsdfSample s = bounce_light_path(params, &v, n, w_in, scatterings, stream, path, &dim, &alpha, &carried);
     if (s.pdf == 0.0f) break;
     const float pdf_rev = s.pdf > 0.0f ? bsdf_pdf(&v.bsdf, n, s.wi, w_in) : 0.0f;
-    weights_at_sample(&d_vcm, &d_vc, s.pdf, pdf_rev, fabs(v3_dot(v.point.normal, s.wi)));
+    weights_at_sample(&d_vcm, &d_vc, &d_vm, m, s.pdf, pdf_rev, fabs(v3_dot(v.point.normal, s.wi)));
     dir = s.wi;
     org = offset_ray_origin(&v.point, s.wi);
   }
@@ -209,7 +236,7 @@ FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, 
 typedef struct {
   LightVertex v;
   lvec3 g, n, wo, beta;
-  float d_vcm, d_vc;
+  float d_vcm, d_vc, d_vm;
   uint scatterings;  // this vertex's count from the camera, 1 for the first hit
 } CameraVertex;
 
@@ -225,8 +252,8 @@ FH_INLINE int unoccluded(const SceneView* scene, lvec3 a, lvec3 b, LightTally* t
 }
 
 // s = 1: a point uniform in the area of a light triangle picked by the light table.
-FH_INLINE lvec3 connect_to_triangle(RenderParams params, const SceneView* scene, const CameraVertex* c, float u_pick,
-                                    float u1, float u2, LightTally* tally) {
+FH_INLINE lvec3 connect_to_triangle(RenderParams params, const SceneView* scene, MergeFactors m, const CameraVertex* c,
+                                    float u_pick, float u1, float u2, LightTally* tally) {
   const int light = scene->light_triangle[pick_light(scene->light_cdf, params.light_count, u_pick)];
   const lvec2 b = sample_triangle(u1, u2);
   const SurfacePoint y = surface_point(scene->triangles, light, b.x, b.y);
@@ -243,7 +270,7 @@ FH_INLINE lvec3 connect_to_triangle(RenderParams params, const SceneView* scene,
   // the light through this vertex (emission density cos_light / pi, times p_A, over p_A).
   const float w_light = mis2(bsdf_pdf(&c->v.bsdf, c->n, c->wo, wi) / pdf_w);
   const float w_camera = mis2(cos_light * cos_g / (M_PI_F * d2)) *
-                         (c->d_vcm + c->d_vc * mis2(bsdf_pdf(&c->v.bsdf, c->n, wi, c->wo)));
+                         (m.vm + c->d_vcm + c->d_vc * mis2(bsdf_pdf(&c->v.bsdf, c->n, wi, c->wo)));
   const float weight = strategy_weight(1.0f / (w_light + 1.0f + w_camera), 1u, c->scatterings);
   const lvec3 value = v3_scale(v3_mul(v3_mul(c->beta, f), le), cos_s * weight / pdf_w);
   if (!v3_any_positive(value)) return v3_splat(0.0f);
@@ -255,7 +282,7 @@ FH_INLINE lvec3 connect_to_triangle(RenderParams params, const SceneView* scene,
 // s = 1 toward the map: a direction drawn from it (density p_w, the pick's included), against
 // BSDF sampling escaping that way and against the light subpaths from the map's disk
 // through this vertex (emission density p_w / (pi R^2), no cosine at the light).
-FH_INLINE lvec3 connect_to_environment(RenderParams params, const SceneView* scene, float4 sphere,
+FH_INLINE lvec3 connect_to_environment(RenderParams params, const SceneView* scene, MergeFactors m, float4 sphere,
                                        const CameraVertex* c, float u1, float u2, LightTally* tally) {
   const EnvironmentSample e = environment_sample(params, scene->env_map, u1, u2);
   const float pdf_w = params.env_pick * e.pdf;
@@ -264,7 +291,7 @@ FH_INLINE lvec3 connect_to_environment(RenderParams params, const SceneView* sce
   const lvec3 f = bsdf_eval(&c->v.bsdf, c->n, c->wo, e.wi);
   const float w_light = mis2(bsdf_pdf(&c->v.bsdf, c->n, c->wo, e.wi) / pdf_w);
   const float w_camera = mis2(cos_g / (M_PI_F * sphere.w * sphere.w)) *
-                         (c->d_vcm + c->d_vc * mis2(bsdf_pdf(&c->v.bsdf, c->n, e.wi, c->wo)));
+                         (m.vm + c->d_vcm + c->d_vc * mis2(bsdf_pdf(&c->v.bsdf, c->n, e.wi, c->wo)));
   const float weight = strategy_weight(1.0f / (w_light + 1.0f + w_camera), 1u, c->scatterings);
   const lvec3 value = v3_scale(v3_mul(v3_mul(c->beta, f), e.radiance), cos_s * weight / pdf_w);
   if (!v3_any_positive(value)) return v3_splat(0.0f);
@@ -278,18 +305,18 @@ FH_INLINE lvec3 connect_to_environment(RenderParams params, const SceneView* sce
 #endif
 
 // s = 1: the light table's pick decides between the map and a triangle.
-FH_INLINE lvec3 connect_to_light(RenderParams params, const SceneView* scene, float4 sphere, const CameraVertex* c,
-                                 float u_pick, float u1, float u2, LightTally* tally) {
+FH_INLINE lvec3 connect_to_light(RenderParams params, const SceneView* scene, MergeFactors m, float4 sphere,
+                                 const CameraVertex* c, float u_pick, float u1, float u2, LightTally* tally) {
   (void)sphere;  // read with FH_ENV_MAP only
 #if defined(FH_ENV_MAP)
-  if (u_pick < params.env_pick) return connect_to_environment(params, scene, sphere, c, u1, u2, tally);
+  if (u_pick < params.env_pick) return connect_to_environment(params, scene, m, sphere, c, u1, u2, tally);
 #endif
-  return params.light_count > 0u ? connect_to_triangle(params, scene, c, u_pick, u1, u2, tally) : v3_splat(0.0f);
+  return params.light_count > 0u ? connect_to_triangle(params, scene, m, c, u_pick, u1, u2, tally) : v3_splat(0.0f);
 }
 
 // s >= 2: the camera vertex joined to a stored light vertex.
-FH_INLINE lvec3 connect_vertices(const SceneView* scene, const CameraVertex* c, __global const float4* s,
-                                 LightTally* tally) {
+FH_INLINE lvec3 connect_vertices(const SceneView* scene, MergeFactors m, const CameraVertex* c,
+                                 __global const float4* s, LightTally* tally) {
   const float4 s0 = s[0], s1 = s[1], s2 = s[2];
   TraceHit hit;
   hit.triangle = as_int(s0.x);
@@ -317,8 +344,8 @@ FH_INLINE lvec3 connect_vertices(const SceneView* scene, const CameraVertex* c, 
   // reaching the light vertex) and one more camera vertex, and all those beyond them.
   const float pdf_camera_a = bsdf_pdf(&c->v.bsdf, c->n, c->wo, w) * cos_l_g / d2;
   const float pdf_light_a = bsdf_pdf(&l.bsdf, n_l, w_in, back) * cos_c_g / d2;
-  const float w_light = mis2(pdf_camera_a) * (s0.w + s1.w * mis2(bsdf_pdf(&l.bsdf, n_l, back, w_in)));
-  const float w_camera = mis2(pdf_light_a) * (c->d_vcm + c->d_vc * mis2(bsdf_pdf(&c->v.bsdf, c->n, w, c->wo)));
+  const float w_light = mis2(pdf_camera_a) * (m.vm + s0.w + s1.w * mis2(bsdf_pdf(&l.bsdf, n_l, back, w_in)));
+  const float w_camera = mis2(pdf_light_a) * (m.vm + c->d_vcm + c->d_vc * mis2(bsdf_pdf(&c->v.bsdf, c->n, w, c->wo)));
   const uint light_scatterings = (uint)s2.w;
   const float weight =
       strategy_weight(1.0f / (w_light + 1.0f + w_camera), light_scatterings + 1u, light_scatterings + c->scatterings);
@@ -327,23 +354,98 @@ FH_INLINE lvec3 connect_vertices(const SceneView* scene, const CameraVertex* c, 
   return unoccluded(scene, from, to, tally) ? v3_scale(value, weight) : v3_splat(0.0f);
 }
 
-__kernel void bdpt(RenderParams params, uint pass, uint first, uint count, float4 sphere, __global float4* stored,
-                   __global const float* filter_table, __global uint* splats, __global const float* density,
-                   __global uint* tallies FH_SCENE_PARAMS) {
-  const uint index = get_global_id(0);
-  if (index >= count) return;
-  const uint path = first + index;
-  if (path >= params.pixel_count) return;
-  const SceneView scene = FH_SCENE_VIEW;
-  const uint stream = hash_combine(params.seed, pass);
-  LightTally tally = {0u, 0u, 0u};
-  __global float4* own = stored + (size_t)index * params.max_depth * FH_BDPT_VERTEX_WORDS;
-  const uint light_vertices =
-      trace_light_subpath(params, &scene, sphere, hash_combine(stream, 1u), path, own, splats, density, &tally);
+#if defined(FH_VCM)
+// The light vertices of a launch filed by cell (render/merge_grid.h): cell (i, j, k) of a
+// grid `cell` wide from `lo` is bucket hash & mask, whose entries (vertex slots: path index
+// in the launch times max_depth, plus the vertex's place in its path) are
+// entries[starts[b]] .. entries[starts[b + 1]] - 1, in slot order.
+typedef struct {
+  __global const float4* stored;
+  __global const uint* starts;
+  __global const uint* entries;
+  float4 lo;      // xyz: the grid's corner, w: 1 / its cells' width (2 r)
+  float radius;   // r
+  float scale;    // 1 / (N pi r^2): a merged light vertex's share of the density estimate
+  uint mask;      // buckets - 1 (a power of two less one)
+} MergeGrid;
 
-  // The camera subpath through pixel `path`, its position offset by the filter. Its numbers
-  // are the pixel's own sequence, point `pass`, in the path tracer's dimensions
-  // (path_state.h): a pixel's first 2^k passes stratify each decision, as under mis.
+// A multiplication, not a division (which OpenCL need not round correctly), so that the
+// host files a vertex in the cell the kernel looks in.
+FH_INLINE int merge_cell(float x, float lo, float inverse_width) { return (int)floor((x - lo) * inverse_width); }
+
+// The grid's bucket of a cell: the host hashes alike (render/merge_grid.cpp).
+FH_INLINE uint merge_bucket(int i, int j, int k, uint mask) {
+  return (((uint)i * 73856093u) ^ ((uint)j * 19349663u) ^ ((uint)k * 83492791u)) & mask;
+}
+
+// The weight a merge at camera vertex c counts with: the power heuristic's, or under
+// FH_VCM_MERGE_ONLY (a test hook) one at the first camera vertex and none elsewhere, so that
+// merging alone renders every path that scatters.
+FH_INLINE float merge_weight(float power_heuristic, const CameraVertex* c) {
+#if defined(FH_VCM_MERGE_ONLY)
+  return c->scatterings == 1u ? 1.0f : 0.0f;
+#else
+  (void)c;
+  return power_heuristic;
+#endif
+}
+
+// Every light vertex within r of camera vertex c merged with it: the light's throughput
+// there times c's BSDF toward where that light came from, over the disk's area and N,
+// weighed against the connections that would make the same path (Georgiev's eqs. 38-39).
+// A merged path has one scattering vertex fewer than its two subpaths together.
+FH_INLINE lvec3 merge_light_vertices(const MergeGrid* grid, MergeFactors m, const CameraVertex* c, uint max_depth) {
+  const lvec3 x = c->v.point.position;
+  const float r = grid->radius, r2 = r * r;
+  const int i0 = merge_cell(x.x - r, grid->lo.x, grid->lo.w), i1 = merge_cell(x.x + r, grid->lo.x, grid->lo.w);
+  const int j0 = merge_cell(x.y - r, grid->lo.y, grid->lo.w), j1 = merge_cell(x.y + r, grid->lo.y, grid->lo.w);
+  const int k0 = merge_cell(x.z - r, grid->lo.z, grid->lo.w), k1 = merge_cell(x.z + r, grid->lo.z, grid->lo.w);
+  uint visited[8];
+  uint visits = 0u;
+  lvec3 sum = v3_splat(0.0f);
+  // Cells 2r wide: a disk of radius r meets at most two a side.
+  for (int k = k0; k <= min(k1, k0 + 1); ++k)
+    for (int j = j0; j <= min(j1, j0 + 1); ++j)
+      for (int i = i0; i <= min(i1, i0 + 1); ++i) {
+        const uint bucket = merge_bucket(i, j, k, grid->mask);
+        int seen = 0;  // two cells may share a bucket: take it once
+        for (uint v = 0u; v < visits; ++v) seen |= visited[v] == bucket;
+        if (seen) continue;
+        visited[visits++] = bucket;
+        for (uint e = grid->starts[bucket]; e < grid->starts[bucket + 1u]; ++e) {
+          __global const float4* s = grid->stored + FH_BDPT_VERTEX_WORDS * grid->entries[e];
+          const float4 s3 = s[3];
+          const lvec3 d = v3_sub(v3(s3.x, s3.y, s3.z), x);
+          if (v3_dot(d, d) > r2) continue;
+          const float4 s0 = s[0], s1 = s[1], s2 = s[2];
+          if ((uint)s2.w + c->scatterings - 1u > max_depth) continue;
+          const lvec3 w_in = v3(s1.x, s1.y, s1.z);
+          const float cos_g = v3_dot(c->g, w_in);  // the light arrived on the camera's side
+          if (!(cos_g > 0.0f)) continue;
+          const lvec3 f = bsdf_eval(&c->v.bsdf, c->n, c->wo, w_in);
+          const float w_light = s0.w * m.vc + s3.w * mis2(bsdf_pdf(&c->v.bsdf, c->n, c->wo, w_in));
+          const float w_camera = c->d_vcm * m.vc + c->d_vm * mis2(bsdf_pdf(&c->v.bsdf, c->n, w_in, c->wo));
+          const float weight = merge_weight(1.0f / (w_light + 1.0f + w_camera), c);
+          sum = v3_add(sum, v3_scale(v3_mul(f, v3(s2.x, s2.y, s2.z)), fabs(v3_dot(c->n, w_in)) / cos_g * weight));
+        }
+      }
+  return v3_scale(v3_mul(c->beta, sum), grid->scale);
+}
+#endif
+
+// The camera subpath through pixel `path`, its position offset by the filter, joined to the
+// `light_vertices` stored at `own` (and under FH_VCM merged with the grid's): the sum of its
+// contributions to its own pixel. Its numbers are the pixel's own sequence, point `pass`, in
+// the path tracer's dimensions (path_state.h): a pixel's first 2^k passes stratify each
+// decision, as under mis.
+#if defined(FH_VCM)
+#define FH_MERGE_GRID_PARAM , const MergeGrid* grid
+#else
+#define FH_MERGE_GRID_PARAM
+#endif
+FH_INLINE lvec3 trace_camera_subpath(RenderParams params, const SceneView* scene, MergeFactors m, float4 sphere,
+                                     uint pass, uint path, __global const float4* own, uint light_vertices,
+                                     __global const float* filter_table, LightTally* tally FH_MERGE_GRID_PARAM) {
   const PixelSampler sampler = pixel_sampler_at(params.seed, pass, path, params.replicates);
   const CameraParams* cam = &params.camera;
   const uint width = (uint)cam->width;
@@ -358,11 +460,12 @@ __kernel void bdpt(RenderParams params, uint pass, uint first, uint count, float
   c.beta = v3_splat(1.0f);
   c.d_vcm = mis2(film_area * cos_camera * cos_camera * cos_camera);  // 1 / the film's density of dir
   c.d_vc = 0.0f;
+  c.d_vm = 0.0f;
   lvec3 sum = v3_splat(0.0f);
 
   for (c.scatterings = 1u; c.scatterings <= params.max_depth + 1u; ++c.scatterings) {
-    if (c.scatterings > 1u) ++tally.bounce_rays;  // the camera ray: the host counts one a pixel
-    const TraceHit hit = trace_ray(scene.nodes, scene.blocks, (float3)(org.x, org.y, org.z),
+    if (c.scatterings > 1u) ++tally->bounce_rays;  // the camera ray: the host counts one a pixel
+    const TraceHit hit = trace_ray(scene->nodes, scene->blocks, (float3)(org.x, org.y, org.z),
                                    (float3)(dir.x, dir.y, dir.z), 0.0f, INFINITY);
     if (hit.triangle < 0) {
       // Escaped: --env with weight one (no strategy but this finds it); the map weighed
@@ -370,7 +473,7 @@ __kernel void bdpt(RenderParams params, uint pass, uint first, uint count, float
       sum = v3_add(sum, v3_mul(c.beta, v3_uniform(vload3(0, params.env))));
 #if defined(FH_ENV_MAP)
       float env_pdf;
-      const lvec3 le = environment_lookup(params, scene.env_map, dir, &env_pdf);
+      const lvec3 le = environment_lookup(params, scene->env_map, dir, &env_pdf);
       const float pdf_w = params.env_pick * env_pdf;
       const float w_camera = c.scatterings == 1u ? 0.0f
                                                  : mis2(pdf_w) * c.d_vcm +
@@ -379,20 +482,20 @@ __kernel void bdpt(RenderParams params, uint pass, uint first, uint count, float
 #endif
       break;
     }
-    c.v = light_vertex(&scene, hit);
+    c.v = light_vertex(scene, hit);
     c.wo = v3_neg(dir);
     const float cos_g = v3_dot(c.v.point.normal, c.wo);
     if (cos_g == 0.0f) break;
-    weights_at_hit(&c.d_vcm, &c.d_vc, hit.t, fabs(cos_g));
+    weights_at_hit(&c.d_vcm, &c.d_vc, &c.d_vm, hit.t, fabs(cos_g));
     c.g = cos_g > 0.0f ? c.v.point.normal : v3_neg(c.v.point.normal);
     c.n = cos_g > 0.0f ? c.v.shading_normal : v3_neg(c.v.shading_normal);
 
     // s = 0: emission from the front, weighed against light sampling (p_A) and the light
     // subpaths leaving from this point (p_A cos / pi); seen directly, the camera's alone.
     if (cos_g > 0.0f) {
-      const lvec3 ke = material_lanes(scene.materials, scene.triangle_material[hit.triangle]).ke;
+      const lvec3 ke = material_lanes(scene->materials, scene->triangle_material[hit.triangle]).ke;
       if (v3_any_positive(ke)) {
-        const float pdf_area = scene.light_pdf_area[hit.triangle];
+        const float pdf_area = scene->light_pdf_area[hit.triangle];
         const float w_camera = c.scatterings == 1u ? 0.0f
                                                    : mis2(pdf_area) * c.d_vcm +
                                                          mis2(pdf_area * cos_g * M_1_PI_F) * c.d_vc;
@@ -404,13 +507,16 @@ __kernel void bdpt(RenderParams params, uint pass, uint first, uint count, float
     const luint dim = (c.scatterings - 1u) * FH_DIMS_PER_BOUNCE;
     if (bsdf_has_smooth_lobe(&c.v.bsdf)) {
       const lvec2 u = sample_2d(&sampler, dim + FH_DIM_LIGHT_U1);
-      sum = v3_add(sum, connect_to_light(params, &scene, sphere, &c, sample_1d(&sampler, dim + FH_DIM_LIGHT_PICK), u.x,
-                                         u.y, &tally));
+      sum = v3_add(sum, connect_to_light(params, scene, m, sphere, &c, sample_1d(&sampler, dim + FH_DIM_LIGHT_PICK),
+                                         u.x, u.y, tally));
       for (uint k = 0u; k < light_vertices; ++k) {
         __global const float4* s = own + FH_BDPT_VERTEX_WORDS * k;
         if (c.scatterings + (uint)s[2].w > params.max_depth) break;  // stored in order of scatterings
-        sum = v3_add(sum, connect_vertices(&scene, &c, s, &tally));
+        sum = v3_add(sum, connect_vertices(scene, m, &c, s, tally));
       }
+#if defined(FH_VCM)
+      sum = v3_add(sum, merge_light_vertices(grid, m, &c, params.max_depth));
+#endif
     }
 
     const lvec2 u = sample_2d(&sampler, dim + FH_DIM_BSDF_U1);
@@ -418,7 +524,7 @@ __kernel void bdpt(RenderParams params, uint pass, uint first, uint count, float
                                      sample_1d(&sampler, dim + FH_DIM_BSDF_LOBE), u.x, u.y);
     if (b.pdf == 0.0f) break;
     const float pdf_rev = b.pdf > 0.0f ? bsdf_pdf(&c.v.bsdf, c.n, b.wi, c.wo) : 0.0f;
-    weights_at_sample(&c.d_vcm, &c.d_vc, b.pdf, pdf_rev, fabs(v3_dot(c.v.point.normal, b.wi)));
+    weights_at_sample(&c.d_vcm, &c.d_vc, &c.d_vm, m, b.pdf, pdf_rev, fabs(v3_dot(c.v.point.normal, b.wi)));
     c.beta = v3_mul(c.beta, b.weight);
     if (c.scatterings >= params.rr_depth) {
       const float survive = fmin(v3_max_component(c.beta), 0.95f);
@@ -429,16 +535,102 @@ __kernel void bdpt(RenderParams params, uint pass, uint first, uint count, float
     dir = b.wi;
     org = offset_ray_origin(&c.v.point, b.wi);
   }
+  return sum;
+}
 
+// Adds a camera subpath's sum to its pixel, and a work-item's tally to the launch's.
+FH_INLINE void finish_path(uint path, lvec3 sum, __global uint* splats, __global uint* tallies, LightTally* tally) {
   if (isfinite(sum.x) && isfinite(sum.y) && isfinite(sum.z)) {
     volatile __global uint* own_pixel = splats + FH_SPLAT_WORDS * path;
     add_quanta(own_pixel, sum.x);
     add_quanta(own_pixel + 2, sum.y);
     add_quanta(own_pixel + 4, sum.z);
   } else {
-    ++tally.nonfinite;
+    ++tally->nonfinite;
   }
+  atomic_add(tallies, tally->bounce_rays);
+  atomic_add(tallies + 1, tally->camera_rays);
+  if (tally->nonfinite) atomic_add(tallies + 2, tally->nonfinite);
+}
+
+#if !defined(FH_VCM)
+// bdpt: a work-item's light subpath, then its camera subpath joined to it.
+__kernel void bdpt(RenderParams params, uint pass, uint first, uint count, float4 sphere, __global float4* stored,
+                   __global const float* filter_table, __global uint* splats, __global const float* density,
+                   __global uint* tallies FH_SCENE_PARAMS) {
+  const uint index = get_global_id(0);
+  if (index >= count) return;
+  const uint path = first + index;
+  if (path >= params.pixel_count) return;
+  const SceneView scene = FH_SCENE_VIEW;
+  const uint stream = hash_combine(params.seed, pass);
+  const MergeFactors none = {0.0f, 0.0f};
+  LightTally tally = {0u, 0u, 0u};
+  __global float4* own = stored + (size_t)index * params.max_depth * FH_BDPT_VERTEX_WORDS;
+  const uint light_vertices =
+      trace_light_subpath(params, &scene, none, sphere, hash_combine(stream, 1u), path, own, splats, density, &tally);
+  const lvec3 sum = trace_camera_subpath(params, &scene, none, sphere, pass, path, own, light_vertices, filter_table,
+                                         &tally);
+  finish_path(path, sum, splats, tallies, &tally);
+}
+#else
+// vcm, first: every light subpath of the launch, its vertices stored and counted.
+__kernel void vcm_light_subpaths(RenderParams params, uint pass, uint first, uint count, float4 sphere, float2 factors,
+                                 __global float4* stored, __global uint* stored_count, __global uint* splats,
+                                 __global const float* density, __global uint* tallies FH_SCENE_PARAMS) {
+  const uint index = get_global_id(0);
+  if (index >= count) return;
+  const uint path = first + index;
+  stored_count[index] = 0u;
+  if (path >= params.pixel_count) return;
+  const SceneView scene = FH_SCENE_VIEW;
+  const uint stream = hash_combine(params.seed, pass);
+  const MergeFactors m = {factors.x, factors.y};
+  LightTally tally = {0u, 0u, 0u};
+  __global float4* own = stored + (size_t)index * params.max_depth * FH_BDPT_VERTEX_WORDS;
+  stored_count[index] =
+      trace_light_subpath(params, &scene, m, sphere, hash_combine(stream, 1u), path, own, splats, density, &tally);
   atomic_add(tallies, tally.bounce_rays);
   atomic_add(tallies + 1, tally.camera_rays);
   if (tally.nonfinite) atomic_add(tallies + 2, tally.nonfinite);
 }
+
+// vcm, next: the stored vertices' positions, path after path (`offsets`: where each path's
+// go, from the host's running sum of the counts), for the host to file in the grid.
+__kernel void vcm_gather_positions(uint count, uint max_depth, __global const float4* stored,
+                                   __global const uint* stored_count, __global const uint* offsets,
+                                   __global float4* positions) {
+  const uint index = get_global_id(0);
+  if (index >= count) return;
+  for (uint k = 0u; k < stored_count[index]; ++k)
+    positions[offsets[index] + k] = stored[((size_t)index * max_depth + k) * FH_BDPT_VERTEX_WORDS + 3u];
+}
+
+// vcm, then: the camera subpaths, joined to their own light subpaths and merged with all of
+// the launch's.
+__kernel void vcm_camera_subpaths(RenderParams params, uint pass, uint first, uint count, float4 sphere,
+                                  float2 factors, float4 grid_lo, float4 grid_merge, __global const float4* stored,
+                                  __global const uint* stored_count, __global const uint* grid_starts,
+                                  __global const uint* grid_entries, __global const float* filter_table,
+                                  __global uint* splats, __global uint* tallies FH_SCENE_PARAMS) {
+  const uint index = get_global_id(0);
+  if (index >= count) return;
+  const uint path = first + index;
+  if (path >= params.pixel_count) return;
+  const SceneView scene = FH_SCENE_VIEW;
+  const MergeFactors m = {factors.x, factors.y};
+  MergeGrid grid;
+  grid.stored = stored;
+  grid.starts = grid_starts;
+  grid.entries = grid_entries;
+  grid.lo = grid_lo;
+  grid.radius = grid_merge.x;
+  grid.scale = grid_merge.y;
+  grid.mask = as_uint(grid_merge.z);
+  LightTally tally = {0u, 0u, 0u};
+  __global const float4* own = stored + (size_t)index * params.max_depth * FH_BDPT_VERTEX_WORDS;
+  const lvec3 sum = trace_camera_subpath(params, &scene, m, sphere, pass, path, own, stored_count[index],
+                                         filter_table, &tally, &grid);
+  finish_path(path, sum, splats, tallies, &tally);
+}
+#endif

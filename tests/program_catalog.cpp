@@ -61,14 +61,15 @@ std::vector<ProgramSpec> programVariants(FeatureSpan span) {
   for (Strategy strategy : {Strategy::Scalar, Strategy::Megakernel8})
     for (const SceneFeatures& features : {SceneFeatures{}, SceneFeatures::all()})
       programs.push_back(pathTracerProgram(features, Method::PT, traversal, strategy, true));
-  // Light tracing (--method lt) and bidirectional path tracing (bdpt): their kernels for every
-  // material feature, and lt's camera paths (mis keeping those that leave the first vertex by
-  // a delta lobe) with glass and mirrors.
-  for (Method method : {Method::LT, Method::BDPT})
+  // Light tracing (--method lt), bidirectional path tracing (bdpt) and vcm: their kernels for
+  // every material feature, and lt's camera paths (mis keeping those that leave the first
+  // vertex by a delta lobe) with glass and mirrors.
+  for (Method method : {Method::LT, Method::BDPT, Method::VCM})
     for (const SceneFeatures& features : materialSets)
       programs.push_back(lightTracerProgram(method, features, traversal));
-  // bdpt's light subpaths from the environment map too.
-  programs.push_back(lightTracerProgram(Method::BDPT, SceneFeatures::all(), traversal));
+  // bdpt's and vcm's light subpaths from the environment map too.
+  for (Method method : {Method::BDPT, Method::VCM})
+    programs.push_back(lightTracerProgram(method, SceneFeatures::all(), traversal));
   for (Strategy strategy : {Strategy::Scalar, Strategy::Simd8, Strategy::Megakernel8})
     programs.push_back(pathTracerProgram(SceneFeatures::all(), Method::LT, traversal, strategy));
   return programs;

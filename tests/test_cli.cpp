@@ -20,7 +20,7 @@ namespace {
 TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
   const std::string dir = test::tempDir("cli");
   const std::pair<const char*, const char*> cases[] = {
-      {"--method foo", "--method 'foo': unknown method (use pt, nee, mis, lt, bdpt or auto)"},
+      {"--method foo", "--method 'foo': unknown method (use pt, nee, mis, lt, bdpt, vcm or auto)"},
       {"--filter tent", "--filter 'tent': unknown filter"},
       {"--env 1,1,x", "--env '1,1,x': 'x' is not a number"},
       {"--aov shiny", "--aov 'shiny': unknown output"},
@@ -41,6 +41,14 @@ TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
       // The strategy and roulette flags.
       {"--strategy vector", "--strategy 'vector': unknown strategy (use auto, scalar, simd8, megakernel or megakernel8)"},
       {"--rr-depth 0", "--rr-depth must be at least 1"},
+      // vcm's merging radius: a fraction of the scene's, and vcm's alone.
+      {"--method vcm --merge-radius 0", "--merge-radius must be a fraction of the scene's radius, from 1e-4 to 1"},
+      {"--method vcm --merge-radius 1e-5", "--merge-radius must be a fraction of the scene's radius"},
+      {"--method vcm --merge-radius nan", "--merge-radius must be a fraction of the scene's radius"},
+      {"--method vcm --merge-radius 1.5", "--merge-radius must be a fraction of the scene's radius"},
+      {"--merge-radius 0.01", "--merge-radius is vcm's (vertex merging); --method mis merges nothing"},
+      {"--method vcm --adaptive", "--method vcm does not go with --adaptive"},
+      {"--method vcm --aovs albedo", "--method vcm records no first surfaces, which --aovs 'albedo' asks for"},
       // What light tracing cannot do yet, named before any work.
       {"--method lt --env 1,1,1", "--method lt traces light paths from the emitting triangles only and does not go with --env;"},
       {"--method lt --env-map /nonexistent/sky.exr", "does not go with --env-map; use mis"},

@@ -57,7 +57,7 @@ TEST(Mpi, EveryRankCountGivesTheImageOfOneProcess) {
 // Light tracing's and bidirectional path tracing's splats (render/light_tracer.h) merge as
 // exactly across ranks.
 TEST(Mpi, LightTracingOnThreeRanksGivesTheImageOfOneProcess) {
-  for (const std::string method : {"lt", "bdpt"}) {
+  for (const std::string method : {"lt", "bdpt", "vcm"}) {
     SCOPED_TRACE(method);
     const std::string dir = test::tempDir("mpi-" + method);
     const std::string args = "render " + test::projectScene("failure/caustic.obj") + " --method " + method +

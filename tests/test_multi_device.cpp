@@ -99,12 +99,13 @@ TEST_F(TwoDevices, MergedImageMatchesAnIndependentSingleDeviceRender) {
   EXPECT_LE(outliers, 2) << outliers << " of " << blocks << " blocks outside 3.29 sigma";
 }
 
-// Light tracing and bidirectional path tracing splat anywhere in the image, as whole film
+// Light tracing, bidirectional path tracing and vcm (whose merging radius follows the global
+// pass) splat anywhere in the image, as whole film
 // quanta added in 64-bit integers (render/light_tracer.h): one device, two devices, and a
 // render in chunks merged all give the same bits. The caustic scene's glass adds camera paths
 // to each of lt's passes too.
 TEST_F(TwoDevices, LightTracingSplatsMergeToTheSameBitsOnAnyDevicesAndChunks) {
-  for (Method method : {Method::LT, Method::BDPT}) {
+  for (Method method : {Method::LT, Method::BDPT, Method::VCM}) {
     SCOPED_TRACE(methodName(method));
     settings.method = method;
     expectSplatsMergeExactly();

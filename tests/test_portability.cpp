@@ -318,7 +318,7 @@ TEST_P(UnderOclgrind, RunsWithoutReports) {
   EXPECT_TRUE(reports.empty()) << run << ": Oclgrind reported:\n" << reports.substr(0, 4000);
 }
 
-INSTANTIATE_TEST_SUITE_P(Runs, UnderOclgrind, ::testing::Values("pt", "nee", "mis", "lt", "bdpt", "aov", "bench", "env", "bdpt_env",
+INSTANTIATE_TEST_SUITE_P(Runs, UnderOclgrind, ::testing::Values("pt", "nee", "mis", "lt", "bdpt", "vcm", "aov", "bench", "env", "bdpt_env",
                                                           "adaptive"),
                          [](const ::testing::TestParamInfo<const char*>& p) { return std::string(p.param); });
 

@@ -35,6 +35,11 @@ struct TestHooks {
   // each strategy's estimator can be tested alone; -1: all of them, weighted. Used by
   // tests/test_path_tracer.cpp.
   int bdptOnlyLightVertices = -1;
+
+  // In-process only: vcm keeps only its merges at the first camera vertex (and the emitters
+  // the camera sees), weight one (kernels/bdpt.cl, FH_VCM_MERGE_ONLY), so that merging's
+  // estimator can be tested alone. Used by tests/test_path_tracer.cpp.
+  bool vcmMergeOnly = false;
 };
 
 // The hooks, parsed from the environment on first use. A malformed value is an Error that

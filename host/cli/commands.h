@@ -26,6 +26,7 @@ struct RenderOptions {
   std::optional<float> envRotate, envScale;
   int maxDepth = RenderSettings{}.maxDepth;
   int rrDepth = RenderSettings{}.rrDepth;
+  std::optional<float> mergeRadius;
   std::optional<size_t> wavefront;  // unset: chosen for each device
   bool allFeatures = false;
   std::string seed = "1";  // the sampler's 32-bit seed, checked by settingsFrom

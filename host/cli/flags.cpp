@@ -17,7 +17,8 @@ Method parseMethod(const std::string& name) {
   if (name == "mis") return Method::MIS;
   if (name == "lt") return Method::LT;
   if (name == "bdpt") return Method::BDPT;
-  throw Error("--method '" + name + "': unknown method (use pt, nee, mis, lt, bdpt or auto)");
+  if (name == "vcm") return Method::VCM;
+  throw Error("--method '" + name + "': unknown method (use pt, nee, mis, lt, bdpt, vcm or auto)");
 }
 
 Strategy parseStrategy(const std::string& name) {

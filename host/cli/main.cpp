@@ -42,7 +42,7 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
   rendering->add_option("--height", o.height, "Image height in pixels")->capture_default_str();
   rendering->add_option("--spp", o.spp, "Samples per pixel (default 64; with --time, the most to take)");
   rendering->add_option("--time", o.seconds, "Time budget in seconds (finishes the pass running then)");
-  rendering->add_option("--method", o.method, "pt (BRDF sampling), nee (light sampling), mis (both), lt (light tracing), bdpt (bidirectional) or auto (a pilot render with each, then the one with the least error per second)")
+  rendering->add_option("--method", o.method, "pt (BRDF sampling), nee (light sampling), mis (both), lt (light tracing), bdpt (bidirectional), vcm (bdpt with vertex merging: caustics seen through glass) or auto (a pilot render with each, then the one with the least error per second)")
       ->capture_default_str();
   rendering->add_option("--noise", o.noise,
                         "Stop once the image's relMSE, estimated from two independently scrambled halves of the "
@@ -56,6 +56,9 @@ CLI::App* addRender(CLI::App& app, RenderOptions& o) {
                         "Russian roulette decides whether paths go on from this bounce on (Mitsuba's rr_depth 5 "
                         "is 6 here)")
       ->capture_default_str();
+  rendering->add_option("--merge-radius", o.mergeRadius,
+                        "vcm: the first pass's merging radius as a fraction of the scene's bounding radius (default "
+                        "0.01; it shrinks pass by pass). Larger: less noise, more blur in caustics");
   rendering->add_option("--env", o.env, "Constant environment radiance R,G,B (default black)");
   rendering->add_option("--env-map", o.envMap,
                         "HDR environment light: a latitude-longitude .exr or .hdr (+y up; the image's centre "

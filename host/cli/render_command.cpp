@@ -115,8 +115,8 @@ void chunkOf(const RenderOptions& o, RenderSettings& s) {
 // Light tracing starts its paths on the scene's emitting triangles (bdpt also on the map) and
 // splats them wherever the camera sees them: what it cannot do yet is an error before any work.
 void lightTracingFits(const RenderOptions& o, const RenderSettings& s) {
-  // bdpt's camera subpaths find --env, and its light subpaths start on the map too.
-  const bool environments = s.method == Method::BDPT;
+  // bdpt's and vcm's camera subpaths find --env, and their light subpaths start on the map too.
+  const bool environments = bidirectional(s.method);
   const char* why = nullptr;
   if (!environments && s.env != std::array<float, 3>{0.f, 0.f, 0.f}) why = "--env";
   else if (!environments && !o.envMap.empty()) why = "--env-map";
@@ -136,7 +136,7 @@ void autoFits(const RenderOptions& o) {
       {!o.aov.empty(), "--aov (a debug view has no method)"}};
   for (const auto& [given, flag] : clashes)
     if (given) throw Error(std::string("--method auto chooses a method per render and does not go with ") + flag +
-                           "; give the method (pt, nee, mis, lt or bdpt)");
+                           "; give the method (pt, nee, mis, lt, bdpt or vcm)");
 }
 
 // --seed: the sampler's seed is 32 bits.
@@ -170,6 +170,10 @@ RenderSettings settingsFrom(const RenderOptions& o) {
   if (!std::isfinite(o.noise) || o.noise < 0) throw Error("--noise must be a finite, non-negative relMSE (e.g. 1e-3; 0: no target)");
   if (o.maxDepth < 1) throw Error("--max-depth must be at least 1");
   if (o.rrDepth < 1) throw Error("--rr-depth must be at least 1");
+  if (o.mergeRadius && !(*o.mergeRadius >= 1e-4f && *o.mergeRadius <= 1.f))
+    throw Error("--merge-radius must be a fraction of the scene's radius, from 1e-4 to 1");
+  if (o.mergeRadius && o.method != "vcm")
+    throw Error("--merge-radius is vcm's (vertex merging); --method " + o.method + " merges nothing");
   if (o.wavefront && *o.wavefront < kLocalSize) throw Error("--wavefront must be at least 64");
   s.width = o.width;
   s.height = o.height;
@@ -181,6 +185,7 @@ RenderSettings settingsFrom(const RenderOptions& o) {
   if (o.adaptive && !o.aov.empty()) throw Error("--adaptive samples a render's noise; --aov renders a debug view");
   s.maxDepth = o.maxDepth;
   s.rrDepth = o.rrDepth;
+  s.mergeRadius = o.mergeRadius.value_or(s.mergeRadius);
   s.seed = parseSeed(o.seed);
   s.wavefront = o.wavefront.value_or(0);
   s.allFeatures = o.allFeatures;

@@ -3,9 +3,12 @@
 #include "render/light_tracer.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstring>
 
 #include "base/test_hooks.h"
 #include "render/kernel_arguments.h"
+#include "render/merge_grid.h"
 #include "render/pixel_filter.h"
 #include "render/wavefront.h"
 
@@ -14,20 +17,21 @@ namespace {
 
 // Per pixel: three 64-bit sums as (low, high) words (kernels/light_paths.h, FH_SPLAT_WORDS).
 constexpr size_t kSplatWords = 6;
-// bdpt: a light vertex's bytes (kernels/bdpt.cl, FH_BDPT_VERTEX_WORDS float4s), and the most
-// a launch's light vertices may take.
-constexpr size_t kVertexBytes = 3 * 16;
-constexpr size_t kVertexBufferBytes = size_t(32) << 20;
+// bdpt and vcm: a light vertex's bytes (kernels/bdpt.cl, FH_BDPT_VERTEX_WORDS float4s), and
+// the most a launch's light vertices may take.
+constexpr size_t kVertexBytes = 4 * 16;
+constexpr size_t kVertexBufferBytes = size_t(64) << 20;
 
 }  // namespace
 
 ProgramSpec lightTracerProgram(Method method, const SceneFeatures& features, const std::string& traversalOptions) {
-  const bool bdpt = method == Method::BDPT;
+  const bool joined = bidirectional(method), vcm = method == Method::VCM;
   const int only = testHooks().bdptOnlyLightVertices;
-  const std::string strategy = bdpt && only >= 0 ? " -DFH_BDPT_ONLY_S=" + std::to_string(only) + "u" : "";
-  return {std::string(bdpt ? "bidirectional path tracer (" : "light tracer (") + methodName(method) +
+  std::string strategy = joined && only >= 0 ? " -DFH_BDPT_ONLY_S=" + std::to_string(only) + "u" : "";
+  if (vcm) strategy += testHooks().vcmMergeOnly ? " -DFH_VCM -DFH_VCM_MERGE_ONLY" : " -DFH_VCM";
+  return {std::string(joined ? "bidirectional path tracer (" : "light tracer (") + methodName(method) +
               features.buildOptions() + strategy + ")",
-          {bdpt ? "bdpt.cl" : "light_trace.cl"}, traversalOptions + features.buildOptions() + strategy + " -DFH_LANES=1"};
+          {joined ? "bdpt.cl" : "light_trace.cl"}, traversalOptions + features.buildOptions() + strategy + " -DFH_LANES=1"};
 }
 
 LightTracer::LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bvh& bvh, const Camera& camera,
@@ -41,7 +45,9 @@ LightTracer::LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bv
       scene_(cameraPaths_ ? cameraPaths_->deviceScene() : *ownScene_),
       pixels_(unsigned(s.width) * unsigned(s.height)),
       method_(s.method),
-      kernelName_(s.method == Method::BDPT ? "bdpt" : "light_trace") {
+      kernelName_(s.method == Method::BDPT   ? "bdpt"
+                  : s.method == Method::VCM ? "vcm_camera_subpaths"
+                                            : "light_trace") {
   std::vector<float> inverseCdf;
   params_ = renderParams(s, camera, scene_, inverseCdf);
   // The splats weigh by the filter's density where camera rays are offset by its inverse CDF.
@@ -51,7 +57,7 @@ LightTracer::LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bv
   const cl::Program program = buildProgram(dc.context, dc.info.device,
                                            lightTracerProgram(method_, scene_.features, scene_.bvh.traversalOptions()));
   kernel_ = createKernel(program, kernelName_);
-  if (method_ == Method::BDPT) {
+  if (bidirectional(method_)) {
     filterTable_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, inverseCdf.size() * 4,
                                   "filter inverse CDF", inverseCdf.data());
     const size_t perPath = size_t(std::max(s.maxDepth, 1)) * kVertexBytes;
@@ -59,6 +65,18 @@ LightTracer::LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bv
     lightVertices_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, pathsPerLaunch_ * perPath,
                                     "bidirectional light vertices");
     for (size_t k = 0; k < 4; ++k) sphere_.s[k] = scene.lights.boundingSphere[k];
+  }
+  if (method_ == Method::VCM) {
+    lightKernel_ = createKernel(program, "vcm_light_subpaths");
+    gatherKernel_ = createKernel(program, "vcm_gather_positions");
+    storedCounts_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, size_t(pathsPerLaunch_) * 4,
+                                   "light vertices per path");
+    offsetsBuffer_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, size_t(pathsPerLaunch_) * 4,
+                                     "light vertices' offsets");
+    positions_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_WRITE_ONLY,
+                                size_t(pathsPerLaunch_) * std::max(s.maxDepth, 1) * 16, "light vertices' positions");
+    firstMergeRadius_ = s.mergeRadius * sphere_.s[3];
+    maxDepth_ = unsigned(std::max(s.maxDepth, 1));
   }
   for (Slot& slot : slots_) {
     slot.splats = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, size_t(pixels_) * kSplatWords * 4,
@@ -95,7 +113,9 @@ void LightTracer::enqueueIteration() {
   static const uint32_t zero = 0;
   FH_CL(dc_.queue.enqueueFillBuffer(slot.splats, zero, 0, size_t(pixels_) * kSplatWords * 4));
   FH_CL(dc_.queue.enqueueFillBuffer(slot.tallies, zero, 0, 16));
-  if (method_ == Method::BDPT) {
+  if (method_ == Method::VCM) {
+    for (unsigned first = 0; first < pixels_; first += pathsPerLaunch_) mergeLaunch(slot, first);
+  } else if (method_ == Method::BDPT) {
     for (unsigned first = 0; first < pixels_; first += pathsPerLaunch_) {
       const unsigned count = std::min(pathsPerLaunch_, pixels_ - first);
       bindAll(kernel_, kernelName_, params_, slot.global, first, count, sphere_, lightVertices_, filterTable_, slot.splats,
@@ -115,6 +135,54 @@ void LightTracer::enqueueIteration() {
   slot.state = State::Launched;
 }
 
+// vcm: a launch's light subpaths, their vertices read back and filed in the merging grid
+// of the pass's radius, then its camera subpaths. The host waits for the light subpaths.
+void LightTracer::mergeLaunch(Slot& slot, unsigned first) {
+  const unsigned count = std::min(pathsPerLaunch_, pixels_ - first);
+  const float radius = mergeRadius(firstMergeRadius_, slot.global);
+  // eta = N pi r^2: merging's density against a connection's (kernels/bdpt.cl MergeFactors).
+  const double eta = double(count) * M_PI * double(radius) * double(radius);
+  // Kept finite in float at any scene scale (a tiny scene's eta^2 underflows).
+  const auto finite = [](double x) { return float(std::clamp(x, 1e-30, 1e30)); };
+  const cl_float2 factors{{finite(eta * eta), finite(1.0 / (eta * eta))}};
+  bindAll(lightKernel_, "vcm_light_subpaths", params_, slot.global, first, count, sphere_, factors, lightVertices_,
+          storedCounts_, slot.splats, density_, slot.tallies, scene_.buffers);
+  cl::Event lightEvent;
+  launch(dc_, lightKernel_, count, "vcm_light_subpaths", &lightEvent);
+  events_.push_back(lightEvent);
+  // Only the stored vertices' positions come back: gathered by the running sum of the counts.
+  counts_.resize(count);
+  FH_CL(dc_.queue.enqueueReadBuffer(storedCounts_, CL_TRUE, 0, counts_.size() * 4, counts_.data()));
+  offsets_.resize(count);
+  uint32_t vertices = 0;
+  for (unsigned p = 0; p < count; ++p) offsets_[p] = vertices, vertices += counts_[p];
+  FH_CL(dc_.queue.enqueueWriteBuffer(offsetsBuffer_, CL_FALSE, 0, size_t(count) * 4, offsets_.data()));
+  bindAll(gatherKernel_, "vcm_gather_positions", count, maxDepth_, lightVertices_, storedCounts_, offsetsBuffer_,
+          positions_);
+  launch(dc_, gatherKernel_, count, "vcm_gather_positions");
+  positionWords_.resize(size_t(vertices) * 4);
+  if (vertices)
+    FH_CL(dc_.queue.enqueueReadBuffer(positions_, CL_TRUE, 0, positionWords_.size() * 4, positionWords_.data()));
+  // A corner below the scene, so cell indices stay small.
+  const float lo[3] = {sphere_.s[0] - sphere_.s[3], sphere_.s[1] - sphere_.s[3], sphere_.s[2] - sphere_.s[3]};
+  grid_ = buildMergeGrid(positionWords_.data(), counts_.data(), count, maxDepth_, radius, lo);
+  gridStarts_ = allocateBuffer(dc_.context, dc_.info.device, CL_MEM_READ_ONLY,
+                               grid_.starts.size() * 4, "merging grid cells", grid_.starts.data());
+  gridEntries_ = allocateBuffer(dc_.context, dc_.info.device, CL_MEM_READ_ONLY,
+                                std::max<size_t>(grid_.entries.size(), 1) * 4, "merging grid entries",
+                                grid_.entries.empty() ? nullptr : grid_.entries.data());
+  uint32_t mask = grid_.mask;
+  float maskBits;
+  std::memcpy(&maskBits, &mask, 4);
+  const cl_float4 gridLo{{lo[0], lo[1], lo[2], grid_.inverseCell}};
+  const cl_float4 merge{{radius, float(1.0 / eta), maskBits, 0.f}};
+  bindAll(kernel_, kernelName_, params_, slot.global, first, count, sphere_, factors, gridLo, merge, lightVertices_,
+          storedCounts_, gridStarts_, gridEntries_, filterTable_, slot.splats, slot.tallies, scene_.buffers);
+  cl::Event event;
+  launch(dc_, kernel_, count, kernelName_, &event);
+  events_.push_back(event);
+}
+
 void LightTracer::readCounters() {
   FH_CL(dc_.queue.finish());
   if (cameraPaths_) cameraPaths_->readCounters();
@@ -123,7 +191,7 @@ void LightTracer::readCounters() {
     slot.state = State::Read;
     stats_.bounceRays += slot.tallyWords[0];
     stats_.shadowRays += slot.tallyWords[1];
-    if (method_ == Method::BDPT) stats_.cameraRays += pixels_;
+    if (bidirectional(method_)) stats_.cameraRays += pixels_;
     stats_.nonfinite += slot.tallyWords[2];
     stats_.iterations += 1;
   }

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "render/device_scene.h"
+#include "render/merge_grid.h"
 #include "render/pass_renderer.h"
 #include "render/wavefront.h"
 #include "scene/camera.h"
@@ -75,10 +76,20 @@ class LightTracer : public PassRenderer {
   // bdpt: the filter's inverse CDF (camera paths) and the light vertices of one launch's paths.
   cl::Buffer filterTable_, lightVertices_;
   unsigned pathsPerLaunch_ = 0;
+  // vcm: the light subpaths' kernel (kernel_ runs the camera subpaths), each launch's
+  // vertices per path, read back with the vertices themselves, and their merging grid.
+  cl::Kernel lightKernel_, gatherKernel_;
+  cl::Buffer storedCounts_, offsetsBuffer_, positions_, gridStarts_, gridEntries_;
+  std::vector<uint32_t> counts_, offsets_;
+  std::vector<float> positionWords_;
+  MergeGrid grid_;
+  float firstMergeRadius_ = 0;
+  unsigned maxDepth_ = 0;
   // bdpt: the scene's bounding sphere (centre, radius), where light subpaths from the
   // environment map start.
   cl_float4 sphere_{};
   std::array<Slot, kSlots> slots_;
+  void mergeLaunch(Slot& slot, unsigned first);
   uint64_t nextLaunch_ = 0, granted_ = 0;  // local passes
   RenderStats stats_;
   double kernelSeconds_ = 0;

@@ -12,6 +12,7 @@ const char* methodName(Method m) {
     case Method::MIS: return "mis";
     case Method::LT: return "lt";
     case Method::BDPT: return "bdpt";
+    case Method::VCM: return "vcm";
   }
   return "?";
 }

@@ -17,12 +17,14 @@ class FilmWatcher;
 class PassLedger;
 
 // pt, nee and mis trace paths from the camera (render/wavefront.h); lt traces them from the
-// lights and connects each vertex to the camera, and bdpt traces both and joins them
-// (render/light_tracer.h).
-enum class Method { PT, NEE, MIS, LT, BDPT };
+// lights and connects each vertex to the camera, bdpt traces both and joins them, and vcm
+// also merges light vertices near camera vertices (render/light_tracer.h).
+enum class Method { PT, NEE, MIS, LT, BDPT, VCM };
 const char* methodName(Method m);
-// lt and bdpt: paths from the emitting triangles, splatted where the camera sees them.
-inline bool tracesLightPaths(Method m) { return m == Method::LT || m == Method::BDPT; }
+// lt, bdpt and vcm: paths from the emitting triangles, splatted where the camera sees them.
+inline bool tracesLightPaths(Method m) { return m == Method::LT || m == Method::BDPT || m == Method::VCM; }
+// bdpt and vcm: camera subpaths joined to light subpaths.
+inline bool bidirectional(Method m) { return m == Method::BDPT || m == Method::VCM; }
 
 enum class PixelFilter { Box, Gaussian, BlackmanHarris };
 const char* filterName(PixelFilter f);
@@ -64,6 +66,9 @@ struct RenderSettings {
   // Russian roulette from this bounce on: later than the minimum because roulette adds
   // variance that, in closed scenes, costs more than the extra bounces (bench/RESULTS.md).
   int rrDepth = 6;
+  // vcm: the first pass's merging radius as a fraction of the scene's bounding radius
+  // (render/merge_grid.h shrinks it pass by pass).
+  float mergeRadius = 0.01f;
   unsigned seed = 1;
   std::array<float, 3> env{0.f, 0.f, 0.f};  // --env: constant radiance, found by BSDF sampling only
   // --env-map: an HDR map lighting the scene, sampled like the triangle lights; null: none.
