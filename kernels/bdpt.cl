@@ -356,13 +356,14 @@ FH_INLINE lvec3 connect_vertices(const SceneView* scene, MergeFactors m, const C
 
 #if defined(FH_VCM)
 // The light vertices of a launch filed by cell (render/merge_grid.h): cell (i, j, k) of a
-// grid `cell` wide from `lo` is bucket hash & mask, whose entries (vertex slots: path index
-// in the launch times max_depth, plus the vertex's place in its path) are
-// entries[starts[b]] .. entries[starts[b + 1]] - 1, in slot order.
+// grid `cell` wide from `lo` is bucket hash & mask, whose entries are
+// filed[starts[b]] .. filed[starts[b + 1] - 1], in slot order: each a vertex's position and
+// (w) its slot's bits (path index in the launch times max_depth, plus its place in its path),
+// side by side so that a lookup reads a bucket's positions from one place.
 typedef struct {
   __global const float4* stored;
   __global const uint* starts;
-  __global const uint* entries;
+  __global const float4* filed;
   float4 lo;      // xyz: the grid's corner, w: 1 / its cells' width (2 r)
   float radius;   // r
   float scale;    // 1 / (N pi r^2): a merged light vertex's share of the density estimate
@@ -400,24 +401,23 @@ FH_INLINE lvec3 merge_light_vertices(const MergeGrid* grid, MergeFactors m, cons
   const int i0 = merge_cell(x.x - r, grid->lo.x, grid->lo.w), i1 = merge_cell(x.x + r, grid->lo.x, grid->lo.w);
   const int j0 = merge_cell(x.y - r, grid->lo.y, grid->lo.w), j1 = merge_cell(x.y + r, grid->lo.y, grid->lo.w);
   const int k0 = merge_cell(x.z - r, grid->lo.z, grid->lo.w), k1 = merge_cell(x.z + r, grid->lo.z, grid->lo.w);
-  uint visited[8];
-  uint visits = 0u;
   lvec3 sum = v3_splat(0.0f);
   // Cells 2r wide: a disk of radius r meets at most two a side.
   for (int k = k0; k <= min(k1, k0 + 1); ++k)
     for (int j = j0; j <= min(j1, j0 + 1); ++j)
       for (int i = i0; i <= min(i1, i0 + 1); ++i) {
         const uint bucket = merge_bucket(i, j, k, grid->mask);
-        int seen = 0;  // two cells may share a bucket: take it once
-        for (uint v = 0u; v < visits; ++v) seen |= visited[v] == bucket;
-        if (seen) continue;
-        visited[visits++] = bucket;
         for (uint e = grid->starts[bucket]; e < grid->starts[bucket + 1u]; ++e) {
-          __global const float4* s = grid->stored + FH_BDPT_VERTEX_WORDS * grid->entries[e];
-          const float4 s3 = s[3];
-          const lvec3 d = v3_sub(v3(s3.x, s3.y, s3.z), x);
+          const float4 p = grid->filed[e];
+          const lvec3 d = v3_sub(v3(p.x, p.y, p.z), x);
           if (v3_dot(d, d) > r2) continue;
-          const float4 s0 = s[0], s1 = s[1], s2 = s[2];
+          // Another cell's vertex in the same bucket is taken with its own cell (two of the
+          // eight cells may share a bucket), as the host filed it.
+          if (merge_cell(p.x, grid->lo.x, grid->lo.w) != i || merge_cell(p.y, grid->lo.y, grid->lo.w) != j ||
+              merge_cell(p.z, grid->lo.z, grid->lo.w) != k)
+            continue;
+          __global const float4* s = grid->stored + FH_BDPT_VERTEX_WORDS * as_uint(p.w);
+          const float4 s0 = s[0], s1 = s[1], s2 = s[2], s3 = s[3];
           if ((uint)s2.w + c->scatterings - 1u > max_depth) continue;
           const lvec3 w_in = v3(s1.x, s1.y, s1.z);
           const float cos_g = v3_dot(c->g, w_in);  // the light arrived on the camera's side
@@ -611,7 +611,7 @@ __kernel void vcm_gather_positions(uint count, uint max_depth, __global const fl
 __kernel void vcm_camera_subpaths(RenderParams params, uint pass, uint first, uint count, float4 sphere,
                                   float2 factors, float4 grid_lo, float4 grid_merge, __global const float4* stored,
                                   __global const uint* stored_count, __global const uint* grid_starts,
-                                  __global const uint* grid_entries, __global const float* filter_table,
+                                  __global const float4* grid_filed, __global const float* filter_table,
                                   __global uint* splats, __global uint* tallies FH_SCENE_PARAMS) {
   const uint index = get_global_id(0);
   if (index >= count) return;
@@ -622,7 +622,7 @@ __kernel void vcm_camera_subpaths(RenderParams params, uint pass, uint first, ui
   MergeGrid grid;
   grid.stored = stored;
   grid.starts = grid_starts;
-  grid.entries = grid_entries;
+  grid.filed = grid_filed;
   grid.lo = grid_lo;
   grid.radius = grid_merge.x;
   grid.scale = grid_merge.y;

@@ -122,13 +122,13 @@ void LightTracer::enqueueIteration() {
               density_, slot.tallies, scene_.buffers);
       cl::Event event;
       launch(dc_, kernel_, count, kernelName_, &event);
-      events_.push_back(event);
+      events_.push_back({kernelName_, event});
     }
   } else {
     bindAll(kernel_, kernelName_, params_, slot.global, slot.splats, density_, slot.tallies, scene_.buffers);
     cl::Event event;
     launch(dc_, kernel_, pixels_, kernelName_, &event);
-    events_.push_back(event);
+    events_.push_back({kernelName_, event});
   }
   FH_CL(dc_.queue.enqueueReadBuffer(slot.splats, CL_FALSE, 0, slot.splatWords.size() * 4, slot.splatWords.data()));
   FH_CL(dc_.queue.enqueueReadBuffer(slot.tallies, CL_FALSE, 0, 12, slot.tallyWords.data()));
@@ -149,7 +149,7 @@ void LightTracer::mergeLaunch(Slot& slot, unsigned first) {
           storedCounts_, slot.splats, density_, slot.tallies, scene_.buffers);
   cl::Event lightEvent;
   launch(dc_, lightKernel_, count, "vcm_light_subpaths", &lightEvent);
-  events_.push_back(lightEvent);
+  events_.push_back({"vcm_light_subpaths", lightEvent});
   // Only the stored vertices' positions come back: gathered by the running sum of the counts.
   counts_.resize(count);
   FH_CL(dc_.queue.enqueueReadBuffer(storedCounts_, CL_TRUE, 0, counts_.size() * 4, counts_.data()));
@@ -168,19 +168,18 @@ void LightTracer::mergeLaunch(Slot& slot, unsigned first) {
   grid_ = buildMergeGrid(positionWords_.data(), counts_.data(), count, maxDepth_, radius, lo);
   gridStarts_ = allocateBuffer(dc_.context, dc_.info.device, CL_MEM_READ_ONLY,
                                grid_.starts.size() * 4, "merging grid cells", grid_.starts.data());
-  gridEntries_ = allocateBuffer(dc_.context, dc_.info.device, CL_MEM_READ_ONLY,
-                                std::max<size_t>(grid_.entries.size(), 1) * 4, "merging grid entries",
-                                grid_.entries.empty() ? nullptr : grid_.entries.data());
+  gridFiled_ = allocateBuffer(dc_.context, dc_.info.device, CL_MEM_READ_ONLY, grid_.filed.size() * 4,
+                              "merging grid's vertices", grid_.filed.empty() ? nullptr : grid_.filed.data());
   uint32_t mask = grid_.mask;
   float maskBits;
   std::memcpy(&maskBits, &mask, 4);
   const cl_float4 gridLo{{lo[0], lo[1], lo[2], grid_.inverseCell}};
   const cl_float4 merge{{radius, float(1.0 / eta), maskBits, 0.f}};
   bindAll(kernel_, kernelName_, params_, slot.global, first, count, sphere_, factors, gridLo, merge, lightVertices_,
-          storedCounts_, gridStarts_, gridEntries_, filterTable_, slot.splats, slot.tallies, scene_.buffers);
+          storedCounts_, gridStarts_, gridFiled_, filterTable_, slot.splats, slot.tallies, scene_.buffers);
   cl::Event event;
   launch(dc_, kernel_, count, kernelName_, &event);
-  events_.push_back(event);
+  events_.push_back({kernelName_, event});
 }
 
 void LightTracer::readCounters() {
@@ -195,11 +194,11 @@ void LightTracer::readCounters() {
     stats_.nonfinite += slot.tallyWords[2];
     stats_.iterations += 1;
   }
-  for (const cl::Event& event : events_) {
+  for (const auto& [name, event] : events_) {
     cl_ulong start = 0, end = 0;
     FH_CL(event.getProfilingInfo(CL_PROFILING_COMMAND_START, &start));
     FH_CL(event.getProfilingInfo(CL_PROFILING_COMMAND_END, &end));
-    stats_.stageSeconds[kernelName_] += double(end - start) * 1e-9;
+    stats_.stageSeconds[name] += double(end - start) * 1e-9;
   }
   events_.clear();
 }

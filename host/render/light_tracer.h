@@ -79,7 +79,7 @@ class LightTracer : public PassRenderer {
   // vcm: the light subpaths' kernel (kernel_ runs the camera subpaths), each launch's
   // vertices per path, read back with the vertices themselves, and their merging grid.
   cl::Kernel lightKernel_, gatherKernel_;
-  cl::Buffer storedCounts_, offsetsBuffer_, positions_, gridStarts_, gridEntries_;
+  cl::Buffer storedCounts_, offsetsBuffer_, positions_, gridStarts_, gridFiled_;
   std::vector<uint32_t> counts_, offsets_;
   std::vector<float> positionWords_;
   MergeGrid grid_;
@@ -93,7 +93,7 @@ class LightTracer : public PassRenderer {
   uint64_t nextLaunch_ = 0, granted_ = 0;  // local passes
   RenderStats stats_;
   double kernelSeconds_ = 0;
-  std::vector<cl::Event> events_;
+  std::vector<std::pair<const char*, cl::Event>> events_;  // each launch's kernel and event
 };
 
 }  // namespace fh

@@ -1,6 +1,7 @@
 #include "render/merge_grid.h"
 
 #include <cmath>
+#include <cstring>
 
 namespace fh {
 
@@ -33,11 +34,16 @@ MergeGrid buildMergeGrid(const float* positions, const uint32_t* counts, unsigne
       ++n;
     }
   for (size_t b = 0; b < buckets; ++b) grid.starts[b + 1] += grid.starts[b];
-  grid.entries.resize(vertices);
+  grid.filed.resize(4 * vertices);
   std::vector<uint32_t> next(grid.starts.begin(), grid.starts.end() - 1);
   n = 0;
   for (unsigned p = 0; p < paths; ++p)
-    for (unsigned k = 0; k < counts[p]; ++k) grid.entries[next[bucketOf[n++]]++] = uint32_t(size_t(p) * maxDepth + k);
+    for (unsigned k = 0; k < counts[p]; ++k, ++n) {
+      float* entry = &grid.filed[4 * size_t(next[bucketOf[n]]++)];
+      std::memcpy(entry, positions + 4 * n, 3 * sizeof(float));
+      const uint32_t slot = uint32_t(size_t(p) * maxDepth + k);
+      std::memcpy(entry + 3, &slot, sizeof(float));
+    }
   return grid;
 }
 

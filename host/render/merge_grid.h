@@ -17,8 +17,10 @@ struct MergeGrid {
   float lo[3] = {0, 0, 0};  // the grid's corner
   float inverseCell = 0;    // 1 / a cell's width, 2 r (kernels/bdpt.cl merge_cell)
   uint32_t mask = 0;        // buckets - 1
-  // Bucket b's entries are entries[starts[b]] .. entries[starts[b + 1]] - 1.
-  std::vector<uint32_t> starts, entries;
+  // Bucket b's vertices are filed[starts[b]] .. filed[starts[b + 1] - 1], a float4 each:
+  // the position and (w) the bits of its slot.
+  std::vector<uint32_t> starts;
+  std::vector<float> filed;
 };
 
 // The grid of radius r over `paths` light paths of `maxDepth` vertex slots each, vertex k
