@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Error against render time for pt, nee, mis, lt and bdpt (and mis+denoise: mis with --denoise, the
+"""Error against render time for pt, nee, mis, lt, bdpt and vcm (and mis+denoise: mis with --denoise, the
 denoised image measured and the denoiser's time added; auto: --method auto, its pilots' time
 added): renders a scene at 1, 2, 4, ... spp with
 each method, measures each image against a reference (`fredholm compare`: relMSE, RMSE,
@@ -134,7 +134,7 @@ def chart(rows, name, args):
 
     fig, ax = plt.subplots(figsize=(6, 4.5))
     for method, color in (("pt", "tab:blue"), ("nee", "tab:orange"), ("mis", "tab:green"),
-                          ("lt", "tab:purple"), ("bdpt", "tab:brown"), ("auto", "black"),
+                          ("lt", "tab:purple"), ("bdpt", "tab:brown"), ("vcm", "tab:olive"), ("auto", "black"),
                           ("mis+denoise", "tab:red")):
         pts = [r for r in rows if r["method"] == method]
         if pts:

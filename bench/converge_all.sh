@@ -16,9 +16,9 @@ chart() {  # chart NAME converge.py-arguments...
   cp "$out/$name.csv" "$out/$name.png" bench/results/convergence/
 }
 
-# Every method, light tracing, bidirectional path tracing and --method auto included (auto's
+# Every method, light tracing, bidirectional path tracing, vcm and --method auto included (auto's
 # points count its pilots).
-methods=pt,nee,mis,lt,bdpt,auto
+methods=pt,nee,mis,lt,bdpt,vcm,auto
 
 # The closed-form scene against its exact image.
 build/fredholm reference builtin:plane-under-light --width 128 --height 128 -o "$out/plane-exact.exr" --force

@@ -15,7 +15,7 @@ import os
 
 import benchlib
 
-METHODS = ("pt", "nee", "mis", "lt", "bdpt", "auto")
+METHODS = ("pt", "nee", "mis", "lt", "bdpt", "vcm", "auto")
 
 
 def read_rows(path):

@@ -62,6 +62,25 @@ typedef struct {
   float vm, vc;
 } MergeFactors;
 
+// Where merging is a strategy: at a smooth vertex whose neighbour toward the camera
+// scatters by a delta lobe, the one place no connection reaches (L S D S E: the diffuse
+// vertex seen through glass). Elsewhere the connections sample every path as merging
+// would, and merging there would only cost lookups. The weights count merging where it is
+// possible and nowhere else, so they still sum to one: on the camera side that is known at
+// the vertex (its last sample), on the light side at the next vertex's sample (the held
+// terms of trace_light_subpath); a vertex joined by a connection, or to the camera, has a
+// smooth neighbour there. Under FH_VCM_MERGE_ONLY (a test hook) merging is at the first
+// camera vertex instead, for every path.
+FH_INLINE int merging_possible(MergeFactors m, int after_delta, uint camera_scatterings) {
+#if defined(FH_VCM_MERGE_ONLY)
+  (void)after_delta;
+  return m.vm > 0.0f && camera_scatterings == 1u;
+#else
+  (void)camera_scatterings;
+  return m.vm > 0.0f && after_delta;
+#endif
+}
+
 // The power heuristic's weight of a density ratio.
 FH_INLINE float mis2(float x) { return x * x; }
 
@@ -91,16 +110,17 @@ FH_INLINE void weights_at_hit(float* d_vcm, float* d_vc, float* d_vm, float d, f
 
 // ... and after a BSDF sample from there (pdf < 0: a delta lobe, whose choice is as likely
 // both ways and whose vertex no connection can use): cos_out at the vertex toward the new
-// direction, pdf_rev the density of sampling the way back.
-FH_INLINE void weights_at_sample(float* d_vcm, float* d_vc, float* d_vm, MergeFactors m, float pdf, float pdf_rev,
-                                  float cos_out) {
+// direction, pdf_rev the density of sampling the way back, merge_here 1 where merging at
+// the vertex left is a strategy for this path (see merging_possible), else 0.
+FH_INLINE void weights_at_sample(float* d_vcm, float* d_vc, float* d_vm, MergeFactors m, float merge_here, float pdf,
+                                  float pdf_rev, float cos_out) {
   if (pdf < 0.0f) {
     *d_vcm = 0.0f;
     *d_vc *= mis2(cos_out);
     *d_vm *= mis2(cos_out);
   } else {
-    *d_vc = mis2(cos_out / pdf) * (*d_vc * mis2(pdf_rev) + *d_vcm + m.vm);
-    *d_vm = mis2(cos_out / pdf) * (*d_vm * mis2(pdf_rev) + *d_vcm * m.vc + 1.0f);
+    *d_vc = mis2(cos_out / pdf) * (*d_vc * mis2(pdf_rev) + *d_vcm + merge_here * m.vm);
+    *d_vm = mis2(cos_out / pdf) * (*d_vm * mis2(pdf_rev) + *d_vcm * m.vc + merge_here);
     *d_vcm = mis2(1.0f / pdf);
   }
 }
@@ -182,6 +202,9 @@ FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, 
   if (!start.valid) return 0u;
   lvec3 alpha = start.alpha, dir = start.dir, org = start.org;
   float d_vcm = start.d_vcm, d_vc = start.d_vc, d_vm = start.d_vm;
+  // Merging at the vertex before, held back: it is a strategy only where this vertex
+  // scatters by a delta lobe (merging_possible), which its sample decides.
+  float held_vc = 0.0f, held_vm = 0.0f;
   lvec3 carried = v3_splat(1.0f);
 
   for (uint scatterings = 1u; scatterings <= params.max_depth; ++scatterings) {
@@ -195,6 +218,8 @@ FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, 
     if (cos_g_in == 0.0f) break;
     // From the map, the first hit is at no distance the light's density knows of.
     weights_at_hit(&d_vcm, &d_vc, &d_vm, start.infinite && scatterings == 1u ? 1.0f : hit.t, fabs(cos_g_in));
+    held_vc /= mis2(cos_g_in);
+    held_vm /= mis2(cos_g_in);
     const lvec3 g = cos_g_in > 0.0f ? v.point.normal : v3_neg(v.point.normal);
     const lvec3 n = cos_g_in > 0.0f ? v.shading_normal : v3_neg(v.shading_normal);
 
@@ -211,7 +236,7 @@ FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, 
       if (view.seen && cos_camera > 0.0f) {
         const lvec3 f = bsdf_eval(&v.bsdf, n, view.to_camera, w_in);
         const float pdf_rev = bsdf_pdf(&v.bsdf, n, view.to_camera, w_in);
-        const float w_light = mis2(view.importance * cos_camera) * (m.vm + d_vcm + d_vc * mis2(pdf_rev));
+        const float w_light = mis2(view.importance * cos_camera) * (d_vcm + d_vc * mis2(pdf_rev));
         const float weight = strategy_weight(1.0f / (1.0f + w_light), scatterings + 1u, scatterings);
         connect_to_camera(params, scene, &view,
                           v3_scale(v3_mul(alpha, f), fabs(v3_dot(n, w_in)) * cos_camera / fabs(cos_g_in) * weight),
@@ -223,7 +248,14 @@ FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, 
     const BsdfSample s = bounce_light_path(params, &v, n, w_in, scatterings, stream, path, &dim, &alpha, &carried);
     if (s.pdf == 0.0f) break;
     const float pdf_rev = s.pdf > 0.0f ? bsdf_pdf(&v.bsdf, n, s.wi, w_in) : 0.0f;
-    weights_at_sample(&d_vcm, &d_vc, &d_vm, m, s.pdf, pdf_rev, fabs(v3_dot(v.point.normal, s.wi)));
+    const float cos_out = fabs(v3_dot(v.point.normal, s.wi));
+    if (s.pdf < 0.0f) {  // the merge at the vertex before is a strategy: a delta lobe here
+      d_vc += held_vc;
+      d_vm += held_vm;
+    }
+    weights_at_sample(&d_vcm, &d_vc, &d_vm, m, 0.0f, s.pdf, pdf_rev, cos_out);
+    held_vc = s.pdf > 0.0f ? mis2(cos_out / s.pdf) * m.vm : 0.0f;
+    held_vm = s.pdf > 0.0f && m.vm > 0.0f ? mis2(cos_out / s.pdf) : 0.0f;
     dir = s.wi;
     org = offset_ray_origin(&v.point, s.wi);
   }
@@ -237,6 +269,7 @@ typedef struct {
   LightVertex v;
   lvec3 g, n, wo, beta;
   float d_vcm, d_vc, d_vm;
+  float merge_here;  // 1 where merging at this vertex is a strategy (merging_possible), else 0
   uint scatterings;  // this vertex's count from the camera, 1 for the first hit
 } CameraVertex;
 
@@ -270,7 +303,7 @@ FH_INLINE lvec3 connect_to_triangle(RenderParams params, const SceneView* scene,
   // the light through this vertex (emission density cos_light / pi, times p_A, over p_A).
   const float w_light = mis2(bsdf_pdf(&c->v.bsdf, c->n, c->wo, wi) / pdf_w);
   const float w_camera = mis2(cos_light * cos_g / (M_PI_F * d2)) *
-                         (m.vm + c->d_vcm + c->d_vc * mis2(bsdf_pdf(&c->v.bsdf, c->n, wi, c->wo)));
+                         (c->merge_here * m.vm + c->d_vcm + c->d_vc * mis2(bsdf_pdf(&c->v.bsdf, c->n, wi, c->wo)));
   const float weight = strategy_weight(1.0f / (w_light + 1.0f + w_camera), 1u, c->scatterings);
   const lvec3 value = v3_scale(v3_mul(v3_mul(c->beta, f), le), cos_s * weight / pdf_w);
   if (!v3_any_positive(value)) return v3_splat(0.0f);
@@ -291,7 +324,7 @@ FH_INLINE lvec3 connect_to_environment(RenderParams params, const SceneView* sce
   const lvec3 f = bsdf_eval(&c->v.bsdf, c->n, c->wo, e.wi);
   const float w_light = mis2(bsdf_pdf(&c->v.bsdf, c->n, c->wo, e.wi) / pdf_w);
   const float w_camera = mis2(cos_g / (M_PI_F * sphere.w * sphere.w)) *
-                         (m.vm + c->d_vcm + c->d_vc * mis2(bsdf_pdf(&c->v.bsdf, c->n, e.wi, c->wo)));
+                         (c->merge_here * m.vm + c->d_vcm + c->d_vc * mis2(bsdf_pdf(&c->v.bsdf, c->n, e.wi, c->wo)));
   const float weight = strategy_weight(1.0f / (w_light + 1.0f + w_camera), 1u, c->scatterings);
   const lvec3 value = v3_scale(v3_mul(v3_mul(c->beta, f), e.radiance), cos_s * weight / pdf_w);
   if (!v3_any_positive(value)) return v3_splat(0.0f);
@@ -344,8 +377,10 @@ FH_INLINE lvec3 connect_vertices(const SceneView* scene, MergeFactors m, const C
   // reaching the light vertex) and one more camera vertex, and all those beyond them.
   const float pdf_camera_a = bsdf_pdf(&c->v.bsdf, c->n, c->wo, w) * cos_l_g / d2;
   const float pdf_light_a = bsdf_pdf(&l.bsdf, n_l, w_in, back) * cos_c_g / d2;
-  const float w_light = mis2(pdf_camera_a) * (m.vm + s0.w + s1.w * mis2(bsdf_pdf(&l.bsdf, n_l, back, w_in)));
-  const float w_camera = mis2(pdf_light_a) * (m.vm + c->d_vcm + c->d_vc * mis2(bsdf_pdf(&c->v.bsdf, c->n, w, c->wo)));
+  // (No merging at the light vertex: its neighbour toward the camera is this smooth join.)
+  const float w_light = mis2(pdf_camera_a) * (s0.w + s1.w * mis2(bsdf_pdf(&l.bsdf, n_l, back, w_in)));
+  const float w_camera =
+      mis2(pdf_light_a) * (c->merge_here * m.vm + c->d_vcm + c->d_vc * mis2(bsdf_pdf(&c->v.bsdf, c->n, w, c->wo)));
   const uint light_scatterings = (uint)s2.w;
   const float weight =
       strategy_weight(1.0f / (w_light + 1.0f + w_camera), light_scatterings + 1u, light_scatterings + c->scatterings);
@@ -461,6 +496,7 @@ FH_INLINE lvec3 trace_camera_subpath(RenderParams params, const SceneView* scene
   c.d_vcm = mis2(film_area * cos_camera * cos_camera * cos_camera);  // 1 / the film's density of dir
   c.d_vc = 0.0f;
   c.d_vm = 0.0f;
+  int after_delta = 0;  // the camera subpath's last sample took a delta lobe
   lvec3 sum = v3_splat(0.0f);
 
   for (c.scatterings = 1u; c.scatterings <= params.max_depth + 1u; ++c.scatterings) {
@@ -489,6 +525,7 @@ FH_INLINE lvec3 trace_camera_subpath(RenderParams params, const SceneView* scene
     weights_at_hit(&c.d_vcm, &c.d_vc, &c.d_vm, hit.t, fabs(cos_g));
     c.g = cos_g > 0.0f ? c.v.point.normal : v3_neg(c.v.point.normal);
     c.n = cos_g > 0.0f ? c.v.shading_normal : v3_neg(c.v.shading_normal);
+    c.merge_here = merging_possible(m, after_delta, c.scatterings) ? 1.0f : 0.0f;
 
     // s = 0: emission from the front, weighed against light sampling (p_A) and the light
     // subpaths leaving from this point (p_A cos / pi); seen directly, the camera's alone.
@@ -515,7 +552,7 @@ FH_INLINE lvec3 trace_camera_subpath(RenderParams params, const SceneView* scene
         sum = v3_add(sum, connect_vertices(scene, m, &c, s, tally));
       }
 #if defined(FH_VCM)
-      sum = v3_add(sum, merge_light_vertices(grid, m, &c, params.max_depth));
+      if (c.merge_here > 0.0f) sum = v3_add(sum, merge_light_vertices(grid, m, &c, params.max_depth));
 #endif
     }
 
@@ -524,7 +561,9 @@ FH_INLINE lvec3 trace_camera_subpath(RenderParams params, const SceneView* scene
                                      sample_1d(&sampler, dim + FH_DIM_BSDF_LOBE), u.x, u.y);
     if (b.pdf == 0.0f) break;
     const float pdf_rev = b.pdf > 0.0f ? bsdf_pdf(&c.v.bsdf, c.n, b.wi, c.wo) : 0.0f;
-    weights_at_sample(&c.d_vcm, &c.d_vc, &c.d_vm, m, b.pdf, pdf_rev, fabs(v3_dot(c.v.point.normal, b.wi)));
+    weights_at_sample(&c.d_vcm, &c.d_vc, &c.d_vm, m, c.merge_here, b.pdf, pdf_rev,
+                      fabs(v3_dot(c.v.point.normal, b.wi)));
+    after_delta = b.pdf < 0.0f;
     c.beta = v3_mul(c.beta, b.weight);
     if (c.scatterings >= params.rr_depth) {
       const float survive = fmin(v3_max_component(c.beta), 0.95f);

@@ -24,8 +24,12 @@ constexpr size_t kVertexBufferBytes = size_t(64) << 20;
 
 }  // namespace
 
+bool mergesLightVertices(Method method, const SceneFeatures& features) {
+  return method == Method::VCM && (features.glass || features.glossy || testHooks().vcmMergeOnly);
+}
+
 ProgramSpec lightTracerProgram(Method method, const SceneFeatures& features, const std::string& traversalOptions) {
-  const bool joined = bidirectional(method), vcm = method == Method::VCM;
+  const bool joined = bidirectional(method), vcm = mergesLightVertices(method, features);
   const int only = testHooks().bdptOnlyLightVertices;
   std::string strategy = joined && only >= 0 ? " -DFH_BDPT_ONLY_S=" + std::to_string(only) + "u" : "";
   if (vcm) strategy += testHooks().vcmMergeOnly ? " -DFH_VCM -DFH_VCM_MERGE_ONLY" : " -DFH_VCM";
@@ -45,8 +49,9 @@ LightTracer::LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bv
       scene_(cameraPaths_ ? cameraPaths_->deviceScene() : *ownScene_),
       pixels_(unsigned(s.width) * unsigned(s.height)),
       method_(s.method),
-      kernelName_(s.method == Method::BDPT   ? "bdpt"
-                  : s.method == Method::VCM ? "vcm_camera_subpaths"
+      merges_(mergesLightVertices(s.method, scene_.features)),
+      kernelName_(merges_                     ? "vcm_camera_subpaths"
+                  : bidirectional(s.method) ? "bdpt"
                                             : "light_trace") {
   std::vector<float> inverseCdf;
   params_ = renderParams(s, camera, scene_, inverseCdf);
@@ -66,7 +71,7 @@ LightTracer::LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bv
                                     "bidirectional light vertices");
     for (size_t k = 0; k < 4; ++k) sphere_.s[k] = scene.lights.boundingSphere[k];
   }
-  if (method_ == Method::VCM) {
+  if (merges_) {
     lightKernel_ = createKernel(program, "vcm_light_subpaths");
     gatherKernel_ = createKernel(program, "vcm_gather_positions");
     storedCounts_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_WRITE, size_t(pathsPerLaunch_) * 4,
@@ -113,9 +118,9 @@ void LightTracer::enqueueIteration() {
   static const uint32_t zero = 0;
   FH_CL(dc_.queue.enqueueFillBuffer(slot.splats, zero, 0, size_t(pixels_) * kSplatWords * 4));
   FH_CL(dc_.queue.enqueueFillBuffer(slot.tallies, zero, 0, 16));
-  if (method_ == Method::VCM) {
+  if (merges_) {
     for (unsigned first = 0; first < pixels_; first += pathsPerLaunch_) mergeLaunch(slot, first);
-  } else if (method_ == Method::BDPT) {
+  } else if (bidirectional(method_)) {
     for (unsigned first = 0; first < pixels_; first += pathsPerLaunch_) {
       const unsigned count = std::min(pathsPerLaunch_, pixels_ - first);
       bindAll(kernel_, kernelName_, params_, slot.global, first, count, sphere_, lightVertices_, filterTable_, slot.splats,

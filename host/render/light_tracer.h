@@ -30,6 +30,11 @@ namespace fh {
 // features: one lane, one light path (and for bdpt one camera path) per work-item.
 ProgramSpec lightTracerProgram(Method method, const SceneFeatures& features, const std::string& traversalOptions);
 
+// Whether vcm merges light vertices in this scene: only where a delta lobe (glass, a
+// mirror) can make merging a strategy (kernels/bdpt.cl merging_possible). Without one, vcm
+// renders bdpt's paths with bdpt's weights, in bdpt's kernel.
+bool mergesLightVertices(Method method, const SceneFeatures& features);
+
 class LightTracer : public PassRenderer {
  public:
   LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bvh& bvh, const Camera& camera,
@@ -70,6 +75,7 @@ class LightTracer : public PassRenderer {
   gpu::RenderParams params_{};
   unsigned pixels_;
   Method method_;
+  bool merges_;  // mergesLightVertices
   const char* kernelName_;
   cl::Kernel kernel_;
   cl::Buffer density_;
