@@ -26,6 +26,15 @@ class SceneBuilder {
     return m;
   }
 
+  // A perfect mirror (illum 3, Ns past the mirror threshold, Ks 1: Schlick's Fresnel is 1).
+  int mirror() {
+    const int m = material(0.f);
+    scene_.materials[size_t(m)].illum = 3;
+    scene_.materials[size_t(m)].ks = {1.f, 1.f, 1.f};
+    scene_.materials[size_t(m)].ns = 10000.f;
+    return m;
+  }
+
   // Triangle a b c, counter-clockwise as seen from its front.
   void triangle(const float3& a, const float3& b, const float3& c, int material) {
     const unsigned base = unsigned(scene_.vertexCount());
@@ -49,15 +58,16 @@ class SceneBuilder {
     else quad(a, d, c, b, material);
   }
 
-  // The six inner faces of the box [lo, hi], fronts facing inward.
-  void closedBoxInside(const float3& lo, const float3& hi, int material) {
+  // The six inner faces of the box [lo, hi], fronts facing inward; the back face (z = lo)
+  // of material `back` where that is not negative.
+  void closedBoxInside(const float3& lo, const float3& hi, int material, int back = -1) {
     const float x0 = lo[0], y0 = lo[1], z0 = lo[2], x1 = hi[0], y1 = hi[1], z1 = hi[2];
     const float3 c = (lo + hi) * 0.5f;
     quadFacing({x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1}, c, material);  // floor
     quadFacing({x0, y1, z0}, {x0, y1, z1}, {x1, y1, z1}, {x1, y1, z0}, c, material);  // ceiling
     quadFacing({x0, y0, z0}, {x0, y0, z1}, {x0, y1, z1}, {x0, y1, z0}, c, material);  // left
     quadFacing({x1, y0, z0}, {x1, y1, z0}, {x1, y1, z1}, {x1, y0, z1}, c, material);  // right
-    quadFacing({x0, y0, z0}, {x0, y1, z0}, {x1, y1, z0}, {x1, y0, z0}, c, material);  // back
+    quadFacing({x0, y0, z0}, {x0, y1, z0}, {x1, y1, z0}, {x1, y0, z0}, c, back < 0 ? material : back);  // back
     quadFacing({x0, y0, z1}, {x1, y0, z1}, {x1, y1, z1}, {x0, y1, z1}, c, material);  // front
   }
 

@@ -1111,6 +1111,29 @@ TEST(Bidirectional, MergingAloneReachesTheClosedForms) {
   expectLambertsPlane(PlaneUnderLight::scene(), Method::VCM, "vcm, merging alone");
 }
 
+// The closed furnace with its back wall a perfect mirror, which the camera faces: radiance
+// is still Le / (1 - rho) everywhere, the mirror's too (it reflects that radiance whole).
+// Every wall seen in the mirror is where vcm merges (a diffuse vertex next to a delta lobe
+// toward the camera), and light subpaths bounce off the mirror between their diffuse
+// vertices, so merging's weights on both sides decide those pixels: a weight that forgets
+// where merging was possible, or counts it where it was not, moves them off the closed form.
+TEST(Bidirectional, AFurnaceWithAMirrorWallStaysUniform) {
+  for (Method method : {Method::MIS, Method::BDPT, Method::VCM}) {
+    RenderSettings s = test::renderSettings();
+    s.method = method;
+    // Light paths enough a launch that merging weighs (eta = N pi r^2 of a few).
+    s.width = s.height = 64;
+    s.spp = 128;
+    const float rho = 0.8f, le = 1.f;
+    SceneBuilder b;
+    b.closedBoxInside({-1, -1, -1}, {1, 1, 1}, b.material(rho, le), b.mirror());
+    const Scene scene = b.build();
+    const RenderResult r = test::render(scene, insideCamera(), s);
+    EXPECT_EQ(r.stats.nonfinite, 0u);
+    expectMatches(r.film, [&](size_t) { return le / (1.0 - rho); }, std::string(methodName(method)) + ", mirror wall");
+  }
+}
+
 // The caustic seen through the ball (L S D S E: a delta vertex on each side of the diffuse
 // one) is found by no connection, only by the camera subpath reaching the small light by
 // BSDF sampling; merging samples it from the light side. At equal samples vcm's image
