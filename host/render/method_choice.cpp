@@ -10,6 +10,8 @@
 #include "base/error.h"
 #include "image/error_metrics.h"
 #include "image/neighbourhood.h"
+#include "render/device_scene.h"
+#include "render/light_tracer.h"
 #include "render/render.h"
 
 namespace fh {
@@ -31,7 +33,10 @@ std::vector<Method> methodsFor(const Scene& scene, const RenderSettings& s) {
   const bool environment = s.env != std::array<float, 3>{0.f, 0.f, 0.f} || s.envMap;
   const bool lightPaths = !s.adaptive && !s.surfaceAovs;  // what neither lt nor bdpt can do
   if (!scene.lights.empty() && !environment && lightPaths) methods.push_back(Method::LT);
-  if ((!scene.lights.empty() || s.envMap) && lightPaths) methods.push_back(Method::BDPT);
+  // vcm where it merges (glass, mirrors): bdpt's strategies and merging too, at about
+  // bdpt's time a sample. Elsewhere it would be bdpt again.
+  const Method joined = mergesLightVertices(Method::VCM, sceneFeatures(scene)) ? Method::VCM : Method::BDPT;
+  if ((!scene.lights.empty() || s.envMap) && lightPaths) methods.push_back(joined);
   return methods;
 }
 

@@ -77,7 +77,10 @@ struct MethodChoice {
 // --env-map: mis is then pt with shadow rays that find nothing); lt where the scene has
 // emitting triangles and nothing it cannot do is asked (an environment, adaptive passes,
 // first-surface layers); bdpt where light subpaths have somewhere to start (emitting
-// triangles or --env-map) and neither adaptive passes nor first-surface layers are asked.
+// triangles or --env-map) and neither adaptive passes nor first-surface layers are asked,
+// vcm in its place where the scene has glass or mirrors (render/light_tracer.h
+// mergesLightVertices: there vcm also samples the diffuse vertex seen through a delta lobe,
+// at about bdpt's time a sample; elsewhere it is bdpt).
 std::vector<Method> methodsFor(const Scene& scene, const RenderSettings& s);
 
 // Of the trials, the method the render should use: the cheapest where it beats mis's cost by
