@@ -5,7 +5,7 @@ against a long reference, over a few seeds; prints the method x scene table of r
 auto's ratio to the best single method and what auto chose.
 
 usage: bench/method_choice.py [--time T] [--seeds 1,2,3] [--ref-spp N] [--width W --height H]
-                              [--methods pt,nee,mis,lt,bdpt,auto] [--out DIR]
+                              [--methods pt,nee,mis,lt,bdpt,vcm,auto] [--scenes caustic,...] [--out DIR]
 
 References are long renders of fredholm itself (lt where a caustic is the error, else mis),
 kept under --out between runs. Their own error (their estimated relMSE) is taken off each
@@ -22,7 +22,7 @@ SCENES = [("cornell-box", "scenes/cornell-box/CornellBox-Original.obj", "mis"),
           ("caustic", "scenes/failure/caustic.obj", "lt"),
           ("hidden-light", "scenes/failure/hidden-light.obj", "mis"),
           ("tiny-light", "scenes/failure/tiny-light.obj", "mis")]
-METHODS = "pt,nee,mis,lt,bdpt,auto"
+METHODS = "pt,nee,mis,lt,bdpt,vcm,auto"
 
 
 def main():
@@ -31,6 +31,8 @@ def main():
                            out=benchlib.scratch_path("method_choice"), seeds="1,2,3", ref_spp=16384)
     p.add_argument("--time", type=float, default=5.0, help="seconds per render (default 5)")
     p.add_argument("--methods", default=METHODS, help=f"methods to render, in turn (default {METHODS})")
+    p.add_argument("--scenes", default=",".join(s[0] for s in SCENES),
+                   help="the scenes to render, by name (default all: %(default)s)")
     args = p.parse_args()
     methods = args.methods.split(",")
     os.makedirs(args.out, exist_ok=True)
@@ -38,7 +40,7 @@ def main():
     auto = "auto" in methods
     print(f"| scene | {' | '.join(methods)} |" + (" auto / best | auto chose |" if auto else ""))
     print("|---|" + "---|" * (len(methods) + (2 if auto else 0)))
-    for name, scene, ref_method in SCENES:
+    for name, scene, ref_method in (s for s in SCENES if s[0] in args.scenes.split(",")):
         scene = os.path.join(benchlib.ROOT, scene)
         ref = os.path.join(args.out, f"{name}-{args.width}x{args.height}-{ref_method}-{args.ref_spp}.exr")
         if not os.path.exists(ref):

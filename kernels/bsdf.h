@@ -20,7 +20,6 @@
 #define FH_LOBE_GLOSSY 2
 #define FH_LOBE_MIRROR 4
 #define FH_LOBE_GLASS 8
-#define FH_NS_MIRROR 1000.0f  // Ns at or above which an illum 3/5/8 surface is a perfect mirror
 
 typedef struct {
   lvec3 kd;             // diffuse albedo (scaled per wo by diffuse_scale)

@@ -28,6 +28,9 @@ typedef std::uint32_t uint;
 #define FH_BVH_WIDTH 8
 #define FH_MAX_LEAF_TRIANGLES 8  // a leaf is one TriangleBlock8
 #define FH_PACKET 8               // rays per work-item in the packet kernels (ray_cast.cl)
+// Ns at or above which an illum 3/5/8 surface is a perfect mirror (bsdf.h; the host's
+// hasDeltaLobes asks the same).
+#define FH_NS_MIRROR 1000.0f
 #define FH_STREAM 64              // rays per work-item in the any-hit stream kernel (a 64-bit mask)
 
 // An 8-wide BVH node: child boxes stored as structure of arrays so one work-item tests

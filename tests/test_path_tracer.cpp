@@ -1134,6 +1134,34 @@ TEST(Bidirectional, AFurnaceWithAMirrorWallStaysUniform) {
   }
 }
 
+// Merging is a strategy only next to a delta lobe (kernels/bdpt.cl merging_possible): a
+// scene with no glass or mirror renders vcm as bdpt, the same bits; a glossy lobe short of
+// a mirror is no delta lobe.
+TEST(Bidirectional, VcmMergesOnlyWhereTheSceneHasADeltaLobe) {
+  SceneBuilder diffuse;
+  diffuse.closedBoxInside({-1, -1, -1}, {1, 1, 1}, diffuse.material(0.5f, 1.f));
+  const Scene box = diffuse.build();
+  EXPECT_FALSE(hasDeltaLobes(box));
+  SceneBuilder mirrored;
+  mirrored.closedBoxInside({-1, -1, -1}, {1, 1, 1}, mirrored.material(0.5f, 1.f), mirrored.mirror());
+  EXPECT_TRUE(hasDeltaLobes(mirrored.build()));
+  SceneBuilder glossy;
+  const int rough = glossy.mirror();
+  glossy.closedBoxInside({-1, -1, -1}, {1, 1, 1}, glossy.material(0.5f, 1.f), rough);
+  Scene glossyBox = glossy.build();
+  glossyBox.materials[size_t(rough)].ns = FH_NS_MIRROR - 1.f;
+  EXPECT_FALSE(hasDeltaLobes(glossyBox));
+  EXPECT_TRUE(hasDeltaLobes(loadScene(test::projectScene("failure/caustic.obj"))));
+
+  RenderSettings s = test::renderSettings();
+  s.width = s.height = 16;
+  s.spp = 16;
+  s.method = Method::BDPT;
+  const Film bdpt = test::render(box, insideCamera(), s).film;
+  s.method = Method::VCM;
+  EXPECT_EQ(test::render(box, insideCamera(), s).film.sum, bdpt.sum);
+}
+
 // The caustic seen through the ball (L S D S E: a delta vertex on each side of the diffuse
 // one) is found by no connection, only by the camera subpath reaching the small light by
 // BSDF sampling; merging samples it from the light side. At equal samples vcm's image

@@ -122,6 +122,16 @@ SceneFeatures sceneFeatures(const Scene& scene) {
   return f;
 }
 
+bool hasDeltaLobes(const Scene& scene) {
+  for (int id : std::set<int>(scene.triangleMaterial.begin(), scene.triangleMaterial.end())) {
+    const Material& m = scene.materials[size_t(id)];
+    const bool specular = m.ks[0] > 0.f || m.ks[1] > 0.f || m.ks[2] > 0.f;
+    const bool mirror = (m.illum == 3 || m.illum == 5 || m.illum == 8) && specular && m.ns >= FH_NS_MIRROR;
+    if (m.isGlass() || mirror) return true;
+  }
+  return false;
+}
+
 namespace {
 
 uint32_t floatBits(float v) {
@@ -192,6 +202,7 @@ TextureData loadTexture(const std::string& path) {
 PreparedScene prepareScene(const Scene& scene, const Bvh& bvh, const SceneFeatures& f, const EnvironmentMap* env) {
   PreparedScene prepared;
   prepared.features = f;
+  prepared.deltaLobes = hasDeltaLobes(scene);
   prepared.lights = buildLightTable(scene, bvh, env);
   const EnvironmentMap black = makeEnvironmentMap("no environment map", 1, 1, {0.f, 0.f, 0.f}, 0.f, 1.f);
   const EnvironmentMap& map = env ? *env : black;

@@ -51,6 +51,10 @@ struct SceneFeatures {
 
 SceneFeatures sceneFeatures(const Scene& scene);
 
+// Whether a material the scene uses has a delta lobe: glass, or a mirror (illum 3, 5 or 8
+// with Ks > 0 and Ns at or past FH_NS_MIRROR, as kernels/bsdf.h decides).
+bool hasDeltaLobes(const Scene& scene);
+
 // A texture as the kernels read it (kernels/surface.h), rows from the top. An 8-bit image
 // keeps its sRGB codes, a 32-bit word per texel (R | G << 8 | B << 16), for the kernels to
 // decode through srgbDecodeTable(): a quarter of the memory of float texels, with the same
@@ -80,6 +84,7 @@ struct SceneBuffers {
 // textures read and decoded, the environment map packed.
 struct PreparedScene {
   SceneFeatures features;
+  bool deltaLobes = false;  // hasDeltaLobes
   LightTable lights;
   std::vector<gpu::GpuMaterial> materials;
   std::vector<int> triangleMaterial;  // BVH order

@@ -24,12 +24,12 @@ constexpr size_t kVertexBufferBytes = size_t(64) << 20;
 
 }  // namespace
 
-bool mergesLightVertices(Method method, const SceneFeatures& features) {
-  return method == Method::VCM && (features.glass || features.glossy || testHooks().vcmMergeOnly);
+bool mergesLightVertices(Method method, bool deltaLobes) {
+  return method == Method::VCM && (deltaLobes || testHooks().vcmMergeOnly);
 }
 
 ProgramSpec lightTracerProgram(Method method, const SceneFeatures& features, const std::string& traversalOptions) {
-  const bool joined = bidirectional(method), vcm = mergesLightVertices(method, features);
+  const bool joined = bidirectional(method), vcm = method == Method::VCM;
   const int only = testHooks().bdptOnlyLightVertices;
   std::string strategy = joined && only >= 0 ? " -DFH_BDPT_ONLY_S=" + std::to_string(only) + "u" : "";
   if (vcm) strategy += testHooks().vcmMergeOnly ? " -DFH_VCM -DFH_VCM_MERGE_ONLY" : " -DFH_VCM";
@@ -49,7 +49,7 @@ LightTracer::LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bv
       scene_(cameraPaths_ ? cameraPaths_->deviceScene() : *ownScene_),
       pixels_(unsigned(s.width) * unsigned(s.height)),
       method_(s.method),
-      merges_(mergesLightVertices(s.method, scene_.features)),
+      merges_(mergesLightVertices(s.method, scene.deltaLobes)),
       kernelName_(merges_                     ? "vcm_camera_subpaths"
                   : bidirectional(s.method) ? "bdpt"
                                             : "light_trace") {
@@ -59,8 +59,10 @@ LightTracer::LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bv
   const std::vector<float> density = filterDensity(s.filter, int(params_.filter_table_size));
   density_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, density.size() * 4, "filter density",
                             density.data());
-  const cl::Program program = buildProgram(dc.context, dc.info.device,
-                                           lightTracerProgram(method_, scene_.features, scene_.bvh.traversalOptions()));
+  // vcm without merging is bdpt, in bdpt's program.
+  const Method programMethod = merges_ || !bidirectional(method_) ? method_ : Method::BDPT;
+  const cl::Program program = buildProgram(
+      dc.context, dc.info.device, lightTracerProgram(programMethod, scene_.features, scene_.bvh.traversalOptions()));
   kernel_ = createKernel(program, kernelName_);
   if (bidirectional(method_)) {
     filterTable_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, inverseCdf.size() * 4,

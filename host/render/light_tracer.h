@@ -30,10 +30,12 @@ namespace fh {
 // features: one lane, one light path (and for bdpt one camera path) per work-item.
 ProgramSpec lightTracerProgram(Method method, const SceneFeatures& features, const std::string& traversalOptions);
 
-// Whether vcm merges light vertices in this scene: only where a delta lobe (glass, a
-// mirror) can make merging a strategy (kernels/bdpt.cl merging_possible). Without one, vcm
-// renders bdpt's paths with bdpt's weights, in bdpt's kernel.
-bool mergesLightVertices(Method method, const SceneFeatures& features);
+// Whether vcm merges light vertices in a scene with (or without) delta lobes
+// (render/device_scene.h hasDeltaLobes): only a delta lobe (glass, a mirror) can make
+// merging a strategy (kernels/bdpt.cl merging_possible). Without one, vcm renders bdpt's
+// paths with bdpt's weights, in bdpt's program. vcm's own program (FH_VCM) is
+// lightTracerProgram(Method::VCM, ...).
+bool mergesLightVertices(Method method, bool deltaLobes);
 
 class LightTracer : public PassRenderer {
  public:

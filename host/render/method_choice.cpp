@@ -35,7 +35,7 @@ std::vector<Method> methodsFor(const Scene& scene, const RenderSettings& s) {
   if (!scene.lights.empty() && !environment && lightPaths) methods.push_back(Method::LT);
   // vcm where it merges (glass, mirrors): bdpt's strategies and merging too, at about
   // bdpt's time a sample. Elsewhere it would be bdpt again.
-  const Method joined = mergesLightVertices(Method::VCM, sceneFeatures(scene)) ? Method::VCM : Method::BDPT;
+  const Method joined = mergesLightVertices(Method::VCM, hasDeltaLobes(scene)) ? Method::VCM : Method::BDPT;
   if ((!scene.lights.empty() || s.envMap) && lightPaths) methods.push_back(joined);
   return methods;
 }
