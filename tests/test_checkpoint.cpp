@@ -19,6 +19,7 @@
 #include "image/image_io.h"
 #include "render/checkpoint.h"
 #include "render/film.h"
+#include "scene/scene_loader.h"
 #include "test_support.h"
 
 namespace fh {
@@ -97,6 +98,58 @@ TEST(Checkpoint, OtherSettingsOrADamagedFileAreRefused) {
   EXPECT_EQ(junk.exitCode, 1);
   EXPECT_NE(junk.output.find("not a fredholm film or checkpoint"), std::string::npos) << junk.output;
   for (const char* f : {"/b.exr", "/c.exr", "/d.exr"}) EXPECT_FALSE(std::filesystem::exists(dir + f)) << f;
+}
+
+// A checkpoint or chunk is refused by a render whose image would differ: every setting
+// that changes the image changes the fingerprint, and none that leaves it alone does.
+TEST(Checkpoint, EverySettingThatChangesTheImageChangesTheFingerprint) {
+  const std::string dir = test::tempDir("fingerprint");
+  const Scene scene = loadScene(test::writeFeatureScene(dir));
+  const Camera camera = scene.camera;
+  RenderSettings base;
+  base.method = Method::VCM;
+  const std::string reference = renderFingerprint(scene, camera, base);
+  const std::vector<std::pair<const char*, void (*)(RenderSettings&)>> changing = {
+      {"width", [](RenderSettings& s) { s.width += 1; }},
+      {"height", [](RenderSettings& s) { s.height += 1; }},
+      {"seed", [](RenderSettings& s) { s.seed += 1; }},
+      {"method", [](RenderSettings& s) { s.method = Method::BDPT; }},
+      {"max depth", [](RenderSettings& s) { s.maxDepth += 1; }},
+      {"roulette depth", [](RenderSettings& s) { s.rrDepth += 1; }},
+      {"merge radius", [](RenderSettings& s) { s.mergeRadius *= 2.f; }},
+      {"env", [](RenderSettings& s) { s.env[1] = 0.5f; }},
+      {"filter", [](RenderSettings& s) { s.filter = PixelFilter::Gaussian; }},
+      {"noise target", [](RenderSettings& s) { s.noise = 1e-3; }},
+      {"adaptive", [](RenderSettings& s) { s.adaptive = true; }},
+      {"surface layers", [](RenderSettings& s) { s.surfaceAovs = true; }}};
+  for (const auto& [what, change] : changing) {
+    RenderSettings s = base;
+    change(s);
+    EXPECT_NE(renderFingerprint(scene, camera, s), reference) << what;
+  }
+  const std::vector<std::pair<const char*, void (*)(RenderSettings&)>> neutral = {
+      {"spp", [](RenderSettings& s) { s.spp *= 2; }},
+      {"time", [](RenderSettings& s) { s.seconds = 5; }},
+      {"wavefront", [](RenderSettings& s) { s.wavefront = 4096; }},
+      {"strategy", [](RenderSettings& s) { s.strategy = Strategy::Megakernel; }},
+      {"all features", [](RenderSettings& s) { s.allFeatures = true; }},
+      {"progress", [](RenderSettings& s) { s.progress = !s.progress; }}};
+  for (const auto& [what, change] : neutral) {
+    RenderSettings s = base;
+    change(s);
+    EXPECT_EQ(renderFingerprint(scene, camera, s), reference) << what;
+  }
+  Camera moved = camera;
+  moved.fovYDeg += 1.f;
+  EXPECT_NE(renderFingerprint(scene, moved, base), reference) << "camera";
+  // The same scene in other units, both brought to the same size: the same image, but a
+  // depth layer in other units.
+  const std::string obj = test::writeFeatureScene(dir);
+  const Scene big = loadScene(test::writeScaledCopy(obj, 40)), bigger = loadScene(test::writeScaledCopy(obj, 50));
+  ASSERT_EQ(big.positions, bigger.positions);
+  EXPECT_NE(renderFingerprint(big, scaledCamera(big.camera, big.worldScale), base),
+            renderFingerprint(bigger, scaledCamera(bigger.camera, bigger.worldScale), base))
+      << "units";
 }
 
 // A film with every section a film file has: sums, sums of squares, surface layers, the odd

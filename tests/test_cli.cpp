@@ -7,11 +7,13 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <utility>
 #include <vector>
 #include <nlohmann/json.hpp>
 
 #include "image/image_io.h"
+#include "render/film.h"
 #include "test_support.h"
 
 namespace fh {
@@ -108,6 +110,16 @@ TEST(RenderCli, StatsAndExrMetadata) {
   EXPECT_EQ(img->spec().get_string_attribute("fredholm:seed"), "7");
   EXPECT_EQ(img->spec().width, 16);
   EXPECT_EQ(img->spec().height, 12);
+  // vcm's radius, with it: the one setting of a method the other flags do not show.
+  const auto vcm = test::runFredholm("render --width 8 --height 8 --spp 2 --method vcm --merge-radius 0.02 -o " + dir +
+                                     "/v.exr --stats " + dir + "/v.json");
+  ASSERT_EQ(vcm.exitCode, 0) << vcm.output;
+  EXPECT_FLOAT_EQ(test::readJson(dir + "/v.json")["merge_radius"].get<float>(), 0.02f);
+  auto vcmImage = OIIO::ImageInput::open(dir + "/v.exr");
+  ASSERT_TRUE(vcmImage);
+  EXPECT_EQ(vcmImage->spec().get_string_attribute("fredholm:merge_radius"), "2.000e-02");
+  EXPECT_FALSE(stats.contains("merge_radius"));
+  EXPECT_EQ(img->spec().get_string_attribute("fredholm:merge_radius"), "");
   // An existing --stats file is kept without --force.
   const auto again = test::runFredholm("render --width 8 --height 8 --spp 1 -o " + dir + "/b.exr --stats " + dir +
                                        "/s.json");
@@ -298,6 +310,37 @@ TEST(ExportCli, BuiltinAndObjScenesRoundTripToTheSameImage) {
   const auto notObj = test::runFredholm("export -o " + dir + "/x.ply");
   EXPECT_EQ(notObj.exitCode, 1);
   EXPECT_NE(notObj.output.find("must end in .obj"), std::string::npos) << notObj.output;
+}
+
+// Single precision holds a length's square and fourth power (densities, bdpt's weights) only
+// near unit size; the loader brings any scene there by a power of two, which is exact. So a
+// scene in any units renders the same bits, and its depth layer is in the file's units.
+TEST(RenderCli, ASceneInAnyUnitsRendersTheSameBits) {
+  const std::string dir = test::tempDir("units");
+  const std::string obj = test::writeFeatureScene(dir);
+  const std::string flags = " --width 12 --height 10 --spp 4 --seed 5 --force ";
+  for (const char* method : {"mis", "vcm"}) {
+    const std::string aovs = std::string(method) == "mis" ? " --aovs depth" : "";
+    const auto base = test::runFredholm("render " + obj + " --method " + method + aovs + flags + "-o " + dir + "/1.exr");
+    ASSERT_EQ(base.exitCode, 0) << base.output;
+    std::vector<std::string> names;
+    const std::vector<float> expected = test::exrChannels(dir + "/1.exr", &names);
+    for (int exponent : {-70, -12, 9, 40, 110}) {
+      const std::string scaled = test::writeScaledCopy(obj, exponent), out = dir + "/" + std::to_string(exponent) + ".exr";
+      const auto r = test::runFredholm("render " + scaled + " --method " + method + aovs + flags + "-o " + out);
+      ASSERT_EQ(r.exitCode, 0) << r.output;
+      EXPECT_EQ(r.output.find("warning"), base.output.find("warning")) << r.output;
+      const std::vector<float> got = test::exrChannels(out);
+      ASSERT_EQ(got.size(), expected.size());
+      size_t differing = 0;
+      for (size_t i = 0; i < got.size(); ++i) {
+        const bool depth = names[i % names.size()] == "depth.Z";
+        const bool hit = depth && expected[i] != kNoDepth;
+        differing += got[i] != (hit ? std::ldexp(expected[i], exponent) : expected[i]);
+      }
+      EXPECT_EQ(differing, 0u) << method << " at 2^" << exponent;
+    }
+  }
 }
 
 TEST(CompareCli, MetricsMeansAndBlocks) {

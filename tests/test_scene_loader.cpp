@@ -603,7 +603,8 @@ TEST_F(BadInput, EveryNumberLoadedReadsAsWritten) {
     char* end = nullptr;
     std::strtod(token.c_str(), &end);
     EXPECT_EQ(*end, '\0') << "'" << token << "' loaded but is not a whole number to strtod";
-    EXPECT_NEAR(scene.positions[0], expected, 1e-6f * std::fabs(expected)) << "'" << token << "'";
+    // In the file's units (a scene far from unit size is scaled by a power of two).
+    EXPECT_NEAR(scene.positions[0] / scene.worldScale, expected, 1e-6f * std::fabs(expected)) << "'" << token << "'";
   }
   EXPECT_GT(loaded, 100u);  // the plain forms load
 }
@@ -683,6 +684,31 @@ TEST_F(BadInput, ExportWritesTexturePathsRelativeToTheMtl) {
   EXPECT_TRUE(fs::equivalent(again.textures[0].path, path("moved/source/maps/wood.png"))) << again.textures[0].path;
   EXPECT_EQ(again.materials[size_t(again.triangleMaterial[0])].kdTexture, 0);
   for (const auto& w : again.warnings) EXPECT_EQ(w.find("texture"), std::string::npos) << w;
+}
+
+// Scenes far from unit size are brought near it by a power of two (exact), in-band ones keep
+// their units, and an export writes the file's units back.
+TEST(SceneLoader, ScenesFarFromUnitSizeAreBroughtNearItExactly) {
+  const std::string dir = test::tempDir("units");
+  const std::string obj = test::writeFeatureScene(dir);  // 2 units across
+  const Scene base = loadScene(obj);
+  EXPECT_EQ(base.worldScale, 1.f);
+  for (int exponent : {-70, -12, -10, 9, 12, 110}) {
+    const Scene scaled = loadScene(test::writeScaledCopy(obj, exponent));
+    const int size = exponent + 1;  // the scaled scene is 2^size across
+    EXPECT_EQ(scaled.worldScale, size >= -10 && size <= 10 ? 1.f : std::ldexp(1.f, -size)) << exponent;
+    ASSERT_EQ(scaled.positions.size(), base.positions.size());
+    size_t differing = 0;
+    for (size_t i = 0; i < base.positions.size(); ++i)
+      differing += scaled.positions[i] != std::ldexp(base.positions[i], exponent) * scaled.worldScale;
+    EXPECT_EQ(differing, 0u) << exponent;
+    const std::string exported = dir + "/exported" + std::to_string(exponent) + ".obj";
+    writeObjScene(scaled, exported, false);
+    const Scene again = loadScene(exported);
+    EXPECT_EQ(again.worldScale, scaled.worldScale) << exponent;
+    EXPECT_EQ(again.positions, scaled.positions) << exponent;
+    EXPECT_EQ(again.camera.eye, scaled.camera.eye) << exponent;
+  }
 }
 
 TEST(SceneLoader, NgonsNegativeIndicesAndCrlf) {

@@ -8,7 +8,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <cmath>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <vector>
 
@@ -125,6 +127,33 @@ std::string writeFeatureScene(const std::string& dir) {
   writeFile(dir + "/features.camera.json",
             R"({"eye": [0, 1, 3.2], "target": [0, 0.9, 0], "up": [0, 1, 0], "fov_y_deg": 45})");
   return dir + "/features.obj";
+}
+
+// See test_support.h.
+std::string writeScaledCopy(const std::string& obj, int exponent) {
+  std::ifstream in(obj);
+  std::ostringstream out;
+  char number[3][32];
+  for (std::string line; std::getline(in, line);) {
+    // Positions, and normals too, which need not be of unit length.
+    if (line.rfind("v ", 0) == 0 || line.rfind("vn ", 0) == 0) {
+      const std::string kind = line.substr(0, line.find(' ') + 1);
+      std::istringstream v(line.substr(kind.size()));
+      float xyz[3];
+      v >> xyz[0] >> xyz[1] >> xyz[2];
+      for (int k = 0; k < 3; ++k) std::snprintf(number[k], sizeof number[k], "%.9g", std::ldexp(xyz[k], exponent));
+      line = kind + number[0] + " " + number[1] + " " + number[2];
+    }
+    out << line << "\n";
+  }
+  const std::filesystem::path base = std::filesystem::path(obj).replace_extension();
+  const std::string copy = base.string() + "-scaled" + std::to_string(exponent);
+  writeFile(copy + ".obj", out.str());
+  nlohmann::json camera = readJson(base.string() + ".camera.json");
+  for (const char* key : {"eye", "target"})
+    for (auto& x : camera[key]) x = std::ldexp(x.get<float>(), exponent);
+  writeFile(copy + ".camera.json", camera.dump());
+  return copy + ".obj";
 }
 
 CommandResult runCommand(const std::string& command_) {

@@ -63,6 +63,11 @@ CommandResult runFredholm(const std::string& args, const std::string& env = "");
 // shading normals and a light; returns the OBJ's path (camera JSON beside it).
 std::string writeFeatureScene(const std::string& dir);
 
+// A copy of the OBJ at `obj` and its camera with every length (and every normal, which need
+// not be of unit length) times 2^exponent (exactly),
+// beside it as NAME-scaledEXPONENT.obj; returns its path.
+std::string writeScaledCopy(const std::string& obj, int exponent);
+
 }  // namespace fh::test
 
 namespace fh::test {

@@ -37,7 +37,7 @@ double median(std::vector<double> v) {
 namespace {
 
 Camera benchCamera(const Scene& scene) {
-  if (scene.hasCamera) return scene.camera;
+  if (scene.hasCamera) return scaledCamera(scene.camera, scene.worldScale);
   Vec3f lo, hi;
   scene.bounds(lo, hi);
   return frameBounds(lo, hi);

@@ -49,14 +49,16 @@ std::string formatSeconds(double s) {
   return out.str();
 }
 
-// --camera FILE, else the scene's sidecar, else framing; then --eye/--target/--up/--fov override.
+// --camera FILE, else the scene's sidecar, else framing; then --eye/--target/--up/--fov
+// override. Given in the scene file's units, returned in the renderer's (Scene::worldScale).
 Camera chooseCamera(const RenderOptions& o, const Scene& scene) {
+  const float toWorld = scene.worldScale;
   Camera camera;
   bool framed = false;
   if (!o.cameraFile.empty()) {
-    camera = loadCameraJson(o.cameraFile);
+    camera = scaledCamera(loadCameraJson(o.cameraFile), toWorld);
   } else if (scene.hasCamera) {
-    camera = scene.camera;
+    camera = scaledCamera(scene.camera, toWorld);
   } else {
     Vec3f lo, hi;
     scene.bounds(lo, hi);
@@ -66,8 +68,8 @@ Camera chooseCamera(const RenderOptions& o, const Scene& scene) {
       std::cerr << "fredholm: no camera given (--camera, --eye/--target, or a .camera.json beside the OBJ): "
                    "framing the scene's bounds\n";
   }
-  if (!o.eye.empty()) camera.eye = parseVec3Flag("--eye", o.eye);
-  if (!o.target.empty()) camera.target = parseVec3Flag("--target", o.target);
+  if (!o.eye.empty()) camera.eye = parseVec3Flag("--eye", o.eye) * toWorld;
+  if (!o.target.empty()) camera.target = parseVec3Flag("--target", o.target) * toWorld;
   if (!o.up.empty()) camera.up = parseVec3Flag("--up", o.up);
   if (o.fov) camera.fovYDeg = *o.fov;
   if (framed && (!isFinite(camera.eye) || !isFinite(camera.target)))
@@ -172,7 +174,7 @@ RenderSettings settingsFrom(const RenderOptions& o) {
   if (o.rrDepth < 1) throw Error("--rr-depth must be at least 1");
   if (o.mergeRadius && !(*o.mergeRadius >= 1e-4f && *o.mergeRadius <= 1.f))
     throw Error("--merge-radius must be a fraction of the scene's radius, from 1e-4 to 1");
-  if (o.mergeRadius && o.method != "vcm")
+  if (o.mergeRadius && o.method != "vcm" && o.method != "auto")  // auto: should it choose vcm
     throw Error("--merge-radius is vcm's (vertex merging); --method " + o.method + " merges nothing");
   if (o.wavefront && *o.wavefront < kLocalSize) throw Error("--wavefront must be at least 64");
   s.width = o.width;
@@ -445,6 +447,7 @@ std::map<std::string, std::string> imageMetadata(const RenderOptions& o, const S
       {"device", r.stats.contributors()}, {"seed", o.seed},     {"seconds", formatSeconds(seconds)},
       {"filter", o.filter},              {"max_depth", std::to_string(o.maxDepth)}};
   if (!o.aovs.empty()) metadata["aovs"] = o.aovs;
+  if (method == "vcm") metadata["merge_radius"] = formatScientific(o.mergeRadius.value_or(RenderSettings{}.mergeRadius));
   if (!o.envMap.empty()) {
     metadata["env_map"] = o.envMap;
     metadata["env_rotate"] = formatSeconds(o.envRotate.value_or(0.f));
@@ -498,6 +501,7 @@ int runRender(RenderOptions o) {
   const Scene scene = loadSceneSpec(o.scene);
   printWarnings(scene);
   const Camera camera = chooseCamera(o, scene);
+  settings.depthUnit = 1.0 / double(scene.worldScale);
   settings.fingerprint = renderFingerprint(scene, camera, settings);
   if (!o.resume.empty()) {
     if (debugView) throw Error("--resume goes on with a render's passes; --aov renders none");

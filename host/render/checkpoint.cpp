@@ -158,7 +158,10 @@ std::string renderFingerprint(const Scene& scene, const Camera& camera, const Re
   f.add(camera.eye).add(camera.target).add(camera.up).add(camera.fovYDeg);
   f.add(s.width).add(s.height).add(s.seed).add(s.method).add(s.maxDepth).add(s.rrDepth).add(s.env).add(s.filter);
   f.add(s.replicates()).add(s.surfaceAovs);
-  if (s.adaptive) f.add(s.adaptive);  // (renders that do not adapt keep their fingerprints)
+  // Added only where they apply, so that other renders keep their fingerprints.
+  if (s.adaptive) f.add(s.adaptive);
+  if (s.method == Method::VCM) f.add(s.mergeRadius);
+  if (scene.worldScale != 1.f) f.add(scene.worldScale);  // the depth layer's units
   if (s.envMap) f.add(s.envMap->width).add(s.envMap->height).add(s.envMap->uShift()).add(s.envMap->texels);
   return f.hex();
 }
@@ -288,7 +291,7 @@ Film loadCheckpoint(const std::string& path, const std::string& fingerprint, con
   SavedFilm f = readFilm(path, flag);
   if (f.fingerprint != fingerprint)
     throw Error(flag + " '" + path + "': saved by a render of another scene, camera or settings (size, seed, "
-                "method, depths, environment, filter, --noise, --aovs); resume with the same ones");
+                "method, depths, --merge-radius, environment, filter, --noise, --aovs); resume with the same ones");
   if (f.film.firstPass() != 0 || !f.film.consecutive())
     throw Error(flag + " '" + path + "': holds passes " + f.film.describePasses() +
                 ", not a checkpoint of passes from 0 on; merge chunks with fredholm merge");
@@ -323,8 +326,8 @@ SavedFilm mergeFilms(const std::vector<std::string>& paths, const std::string& f
     if (saved.fingerprint != expected)
       throw Error(flag + " '" + path + "': is a chunk of another render than " +
                   (fingerprint.empty() ? "'" + films.front().first + "'" : std::string("this one")) +
-                  " (another scene, camera or settings: size, seed, method, depths, environment, filter, --noise, "
-                  "--aovs)");
+                  " (another scene, camera or settings: size, seed, method, depths, --merge-radius, environment, "
+                  "filter, --noise, --aovs)");
   // In the order of their first passes: the sums of squares, not exact, then add up alike.
   std::stable_sort(films.begin(), films.end(), [](const auto& a, const auto& b) {
     return a.second.film.firstPass() < b.second.film.firstPass();

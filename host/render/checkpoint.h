@@ -14,7 +14,8 @@
 namespace fh {
 
 // What makes two renders the same image: the scene's geometry, materials and textures (by
-// path), the camera, and the settings that change samples (size, seed, method, depths,
+// path), the camera, the scene's units (Scene::worldScale: the depth layer's), and the
+// settings that change samples (size, seed, method, depths, vcm's merging radius,
 // environment, filter, the sampler's replicates, the surface layers). Not the sample count
 // or time (a resumed render may go further), nor the strategy or devices (all compute the
 // same bits). A hex string.

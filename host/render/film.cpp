@@ -90,7 +90,7 @@ void Film::addPass(uint64_t pass, const std::vector<float>& samples, const std::
       out[3 + c] += quantized(in[4 + c]);
     }
     if (in[7] > 0.f) {
-      out[6] += quantized(in[7]);
+      out[6] += quantized(in[7]) * depthUnit;  // a power of two: exact
       out[7] += 1.0;
     }
   }

@@ -44,8 +44,10 @@ Image renderAov(DeviceContext& dc, const Scene& scene, const Bvh& bvh, const Cam
   image.width = s.width;
   image.height = s.height;
   image.rgb.resize(size_t(pixels) * 3);
+  const float unit = s.mode == Aov::Depth ? 1.f / scene.worldScale : 1.f;  // depth in the file's units
   for (size_t p = 0; p < pixels; ++p)
-    for (size_t c = 0; c < 3; ++c) image.rgb[3 * p + c] = sums[4 * p + 3] > 0.f ? sums[4 * p + c] / sums[4 * p + 3] : 0.f;
+    for (size_t c = 0; c < 3; ++c)
+      image.rgb[3 * p + c] = sums[4 * p + 3] > 0.f ? sums[4 * p + c] / sums[4 * p + 3] * unit : 0.f;
   return image;
 }
 

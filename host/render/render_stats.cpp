@@ -74,6 +74,7 @@ std::string statsJson(const RenderStats& st, const RenderSettings& s) {
       {"rays", {{"camera", st.cameraRays}, {"bounce", st.bounceRays}, {"shadow", st.shadowRays}, {"total", rays}}},
       {"rays_per_second", st.seconds > 0 ? double(rays) / st.seconds : 0.0},
       {"kernels", kernels}};
+  if (s.method == Method::VCM) doc["merge_radius"] = s.mergeRadius;
   if (!st.ranks.empty()) {
     const double pixels = double(s.width) * double(s.height);
     nlohmann::json ranks = nlohmann::json::array();

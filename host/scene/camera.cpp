@@ -1,6 +1,7 @@
 // Camera sources and the camera basis.
 #include "scene/camera.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -28,6 +29,14 @@ std::array<float, 3> readVec3(const nlohmann::json& j, const char* key, const st
   std::array<float, 3> out{};
   for (size_t k = 0; k < 3; ++k) out[k] = toFloat(v[k], path, key);
   return out;
+}
+
+// (x, y, z) scaled by the power of two (exact) that brings its largest component into
+// [1, 2): a vector whose square neither over- nor underflows, whatever the scene's units.
+float3 atUnitScale(double x, double y, double z) {
+  const double largest = std::max({std::fabs(x), std::fabs(y), std::fabs(z)});
+  const int e = largest > 0.0 ? -std::ilogb(largest) : 0;
+  return {float(std::ldexp(x, e)), float(std::ldexp(y, e)), float(std::ldexp(z, e))};
 }
 
 }  // namespace
@@ -60,17 +69,13 @@ void validateCamera(const Camera& c, const std::string& source) {
     throw Error(source + ": camera values must be finite");
   if (!(c.fovYDeg > 0.f && c.fovYDeg < 180.f))
     throw Error(source + ": vertical field of view must lie in (0, 180) degrees");
-  // In double first: in float, (target - eye) or its squared length may overflow, which
-  // would show up below as a misleading "parallel" or "coincide".
+  // In double: in float, (target - eye) or its squared length may underflow.
   double distance2 = 0.0;
   for (size_t k = 0; k < 3; ++k) distance2 += std::pow(double(c.target[k]) - double(c.eye[k]), 2);
   if (distance2 == 0.0) throw Error(source + ": camera eye and target coincide");
   const CameraFrame frame = makeCameraFrame(c, 1, 1);
-  if (!isFinite(frame.forward) || !(std::fabs(length(frame.forward) - 1.f) < 1e-3f))
-    throw Error(source + ": camera eye and target are too far apart (" + std::to_string(std::sqrt(distance2)) +
-                ") for single precision");
-  if (!isFinite(frame.right) || length(cross(frame.forward, c.up)) < 1e-6f)
-    throw Error(source + ": camera up vector is parallel to the view direction (or too large)");
+  if (!isFinite(frame.right) || length(cross(frame.forward, atUnitScale(c.up[0], c.up[1], c.up[2]))) < 1e-6f)
+    throw Error(source + ": camera up vector is zero or parallel to the view direction");
 }
 
 Camera frameBounds(const std::array<float, 3>& lo, const std::array<float, 3>& hi, float fovYDeg) {
@@ -85,11 +90,20 @@ Camera frameBounds(const std::array<float, 3>& lo, const std::array<float, 3>& h
   return c;
 }
 
+Camera scaledCamera(Camera camera, float scale) {
+  for (size_t k = 0; k < 3; ++k) {
+    camera.eye[k] *= scale;
+    camera.target[k] *= scale;
+  }
+  return camera;
+}
+
 CameraFrame makeCameraFrame(const Camera& c, int width, int height) {
   CameraFrame f;
   f.origin = c.eye;
-  f.forward = normalize(c.target - c.eye);
-  f.right = normalize(cross(f.forward, c.up));
+  f.forward = normalize(
+      atUnitScale(double(c.target[0]) - c.eye[0], double(c.target[1]) - c.eye[1], double(c.target[2]) - c.eye[2]));
+  f.right = normalize(cross(f.forward, atUnitScale(c.up[0], c.up[1], c.up[2])));
   f.up = cross(f.right, f.forward);
   f.tanHalfFovY = std::tan(0.5f * c.fovYDeg * float(M_PI) / 180.f);
   f.aspect = float(width) / float(height);

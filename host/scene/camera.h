@@ -34,12 +34,16 @@ Camera parseCameraJson(const std::string& text, const std::string& name);
 
 // Parses "x,y,z" given to `flag`; errors name the flag.
 
-// Throws fh::Error (naming `source`) if eye == target, up is parallel to the view
+// Throws fh::Error (naming `source`) if eye == target, up is zero or parallel to the view
 // direction, a value is not finite or the fov is outside (0, 180).
 void validateCamera(const Camera& camera, const std::string& source);
 
 // A camera that looks at the box [lo, hi] from +Z, framing it whole.
 Camera frameBounds(const std::array<float, 3>& lo, const std::array<float, 3>& hi, float fovYDeg = 40.f);
+
+// The camera with its eye and target scaled by `scale` (Scene::worldScale: from the
+// scene file's units to the renderer's); the view is the same.
+Camera scaledCamera(Camera camera, float scale);
 
 CameraFrame makeCameraFrame(const Camera& camera, int width, int height);
 

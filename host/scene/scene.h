@@ -52,7 +52,12 @@ struct Scene {
   std::vector<Light> lights;
   std::vector<std::string> warnings;
   bool hasCamera = false;                // a camera sidecar was found next to the OBJ
-  Camera camera;
+  Camera camera;                         // in the file's units
+  // The renderer's lengths are the file's times this: a power of two, so the scaling is
+  // exact and the image the same bits, chosen by the loader (scene_loader.h) to bring a
+  // scene far from unit size near it. Single precision holds a length's square (area
+  // densities) and fourth power (bdpt's weights) only for lengths from about 2^-32 to 2^32.
+  float worldScale = 1.f;
 
   size_t triangleCount() const { return indices.size() / 3; }
   size_t vertexCount() const { return positions.size() / 3; }

@@ -123,9 +123,48 @@ void checkIndices(const std::string& objName, const tinyobj::attrib_t& attrib,
   }
 }
 
+// Scenes whose size (the largest side of the box around their faces' vertices) lies within
+// [2^-kWorldScaleBand, 2^kWorldScaleBand] keep their units; others are scaled by a power of
+// two to a size in [1, 2), never so far that a coordinate would pass 2^kMaxScaledExponent.
+constexpr int kWorldScaleBand = 10;
+constexpr int kMaxScaledExponent = 100;
+
+// Scene::worldScale for these faces' vertices, applied to the positions.
+float scaleToWorld(std::vector<float>& positions, const std::vector<tinyobj::shape_t>& shapes) {
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, magnitude = 0.0;
+  for (const auto& shape : shapes)
+    for (const auto& idx : shape.mesh.indices)
+      for (size_t k = 0; k < 3; ++k) {
+        const double v = positions[3 * size_t(idx.vertex_index) + k];
+        lo[k] = std::min(lo[k], v);
+        hi[k] = std::max(hi[k], v);
+        magnitude = std::max(magnitude, std::fabs(v));
+      }
+  const double size = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  if (!(size > 0.0) || !std::isfinite(size) || !(magnitude > 0.0)) return 1.f;  // the lint's and BVH's to refuse
+  if (size >= std::ldexp(1.0, -kWorldScaleBand) && size <= std::ldexp(1.0, kWorldScaleBand)) return 1.f;
+  const int exponent = std::min(-std::ilogb(size), kMaxScaledExponent - std::ilogb(magnitude));
+  for (float& p : positions) p = std::ldexp(p, exponent);
+  return std::ldexp(1.f, exponent);
+}
+
+// A triangle's three corner normals scaled alike by a power of two (exact: their
+// interpolation keeps its direction) where their largest component lies outside
+// [2^-kWorldScaleBand, 2^kWorldScaleBand], to one in [1, 2): the kernels normalize the
+// interpolated normal through its square, which must neither over- nor underflow.
+void bringNearUnitLength(float* normals) {
+  float largest = 0.f;
+  for (int i = 0; i < 9; ++i) largest = std::max(largest, std::fabs(normals[i]));
+  if (!(largest > 0.f) || !std::isfinite(largest)) return;
+  const int exponent = std::ilogb(largest);
+  if (std::abs(exponent) <= kWorldScaleBand) return;
+  for (int i = 0; i < 9; ++i) normals[i] = std::ldexp(normals[i], -exponent);
+}
+
 void flattenShapes(Scene& scene, const tinyobj::attrib_t& attrib, const std::vector<tinyobj::shape_t>& shapes,
                    int defaultMaterial) {
   scene.positions.assign(attrib.vertices.begin(), attrib.vertices.end());
+  scene.worldScale = scaleToWorld(scene.positions, shapes);
   bool anyNormals = false, anyUVs = false;
   for (const auto& shape : shapes)
     for (const auto& idx : shape.mesh.indices) {
@@ -162,6 +201,7 @@ void flattenShapes(Scene& scene, const tinyobj::attrib_t& attrib, const std::vec
             scene.cornerUVs.push_back(has ? attrib.texcoords[2 * size_t(idx.texcoord_index) + size_t(j)] : 0.f);
         }
       }
+      if (anyNormals) bringNearUnitLength(&scene.cornerNormals[9 * t]);
     }
   }
   if (noMaterial)
