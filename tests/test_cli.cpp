@@ -3,6 +3,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -340,6 +341,54 @@ TEST(RenderCli, ASceneInAnyUnitsRendersTheSameBits) {
       }
       EXPECT_EQ(differing, 0u) << method << " at 2^" << exponent;
     }
+  }
+}
+
+// The film keeps whole quanta of a fixed size and light paths' splats are capped, both at
+// unit brightness: a scene lit by emitters far from it renders in a unit of its own (a power
+// of two), the same arithmetic whatever that unit, so the image of emitters 2^k as bright is
+// 2^k times the image, to the bit; and like the scene of unit brightness (its quanta aside).
+TEST(RenderCli, EmittersOfAnyBrightnessRenderTheSameImageScaled) {
+  const std::string dir = test::tempDir("radiance");
+  const std::string obj = test::writeFeatureScene(dir);  // its light: Ke 8 8 8
+  std::ifstream in(dir + "/features.mtl");
+  const std::string mtl((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string flags = " --width 12 --height 10 --spp 4 --seed 5 --force ";
+  // The image with the light (and --env) 2^exponent as bright.
+  auto render = [&](const std::string& method, int exponent, bool env) {
+    auto scaled = [&](double v) {
+      char text[32];
+      std::snprintf(text, sizeof text, "%.9g", std::ldexp(v, exponent));
+      return std::string(text);
+    };
+    std::string brighter = mtl;
+    brighter.replace(brighter.find("Ke 8 8 8"), 8, "Ke " + scaled(8) + " " + scaled(8) + " " + scaled(8));
+    test::writeFile(dir + "/features.mtl", brighter);
+    const std::string envFlag = env ? " --env " + scaled(0.25) + "," + scaled(0.25) + "," + scaled(0.25) : "";
+    const std::string out = dir + "/" + method + std::to_string(exponent) + ".exr";
+    const auto r = test::runFredholm("render " + obj + " --method " + method + envFlag + flags + "-o " + out);
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    test::writeFile(dir + "/features.mtl", mtl);
+    return test::exrChannels(out);
+  };
+  for (const char* method : {"mis", "lt", "vcm"}) {
+    const bool env = std::string(method) == "mis";  // lt takes no environment
+    const std::vector<float> expected = render(method, 20, env), unit = render(method, 0, env);
+    ASSERT_FALSE(expected.empty());
+    ASSERT_GT(*std::max_element(unit.begin(), unit.end()), 0.f) << method;
+    for (int exponent : {-60, -20, 40, 100}) {
+      const std::vector<float> got = render(method, exponent, env);
+      ASSERT_EQ(got.size(), expected.size());
+      size_t differing = 0;
+      for (size_t i = 0; i < got.size(); ++i) differing += got[i] != std::ldexp(expected[i], exponent - 20);
+      EXPECT_EQ(differing, 0u) << method << " at 2^" << exponent;
+    }
+    double sum = 0.0, unitSum = 0.0;
+    for (size_t i = 0; i < unit.size(); ++i) {
+      sum += std::ldexp(double(expected[i]), -20);
+      unitSum += unit[i];
+    }
+    EXPECT_NEAR(sum, unitSum, 1e-5 * unitSum) << method;
   }
 }
 

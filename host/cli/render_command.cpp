@@ -26,6 +26,7 @@
 #include "image/image_io.h"
 #include "render/checkpoint.h"
 #include "render/method_choice.h"
+#include "render/radiance_unit.h"
 #include "render/render.h"
 #include "render/render_aov.h"
 #include "render/wavefront.h"
@@ -498,9 +499,10 @@ int runRender(RenderOptions o) {
                 std::to_string(devices.size()) + "; pick one (e.g. --device " + std::to_string(devices[0].index) +
                 ")");
 
-  const Scene scene = loadSceneSpec(o.scene);
+  Scene scene = loadSceneSpec(o.scene);
   printWarnings(scene);
   const Camera camera = chooseCamera(o, scene);
+  settings.radianceUnit = toRadianceUnit(scene, settings);
   settings.depthUnit = 1.0 / double(scene.worldScale);
   settings.fingerprint = renderFingerprint(scene, camera, settings);
   if (!o.resume.empty()) {

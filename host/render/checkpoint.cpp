@@ -162,6 +162,7 @@ std::string renderFingerprint(const Scene& scene, const Camera& camera, const Re
   if (s.adaptive) f.add(s.adaptive);
   if (s.method == Method::VCM) f.add(s.mergeRadius);
   if (scene.worldScale != 1.f) f.add(scene.worldScale);  // the depth layer's units
+  if (s.radianceUnit != 1.0) f.add(s.radianceUnit);     // the image's, its emission scaled to it
   if (s.envMap) f.add(s.envMap->width).add(s.envMap->height).add(s.envMap->uShift()).add(s.envMap->texels);
   return f.hex();
 }

@@ -77,7 +77,7 @@ void Film::addPass(uint64_t pass, const std::vector<float>& samples, const std::
   for (size_t i = 0; i < count; ++i) {
     const size_t p = covered ? (*covered)[i] : i;
     for (size_t c = 0; c < 4; ++c) {
-      const double v = quantized(samples[4 * i + c]);
+      const double v = quantized(samples[4 * i + c]) * (c == 3 ? 1.0 : radianceUnit);  // a power of two: exact
       sum[4 * p + c] += v;
       if (c != 3) sumSq[4 * p + c] += v * v;
       if (odd) oddSum[kOddSumsPerPixel * p + c] += v;
@@ -90,7 +90,7 @@ void Film::addPass(uint64_t pass, const std::vector<float>& samples, const std::
       out[3 + c] += quantized(in[4 + c]);
     }
     if (in[7] > 0.f) {
-      out[6] += quantized(in[7]) * depthUnit;  // a power of two: exact
+      out[6] += quantized(in[7]) * depthUnit;
       out[7] += 1.0;
     }
   }

@@ -93,9 +93,10 @@ struct Film {
   bool hasSurfaceAovs() const { return !aovSum.empty(); }
 
   int width = 0, height = 0;
-  // The scene file's lengths per renderer length (1 / Scene::worldScale): addPass records
-  // depths in the file's units. Not saved: a film's sums are in the file's units already.
-  double depthUnit = 1.0;
+  // The scene's radiance per renderer radiance (render/radiance_unit.h) and its lengths per
+  // renderer length (1 / Scene::worldScale): addPass records a pass's samples and depths in
+  // the scene's units. Not saved: a film's sums are in the scene's units already.
+  double radianceUnit = 1.0, depthUnit = 1.0;
   std::vector<double> sum, sumSq;
   // Per pixel: albedo rgb, normal xyz, depth, samples that hit (sums in pass order).
   std::vector<double> aovSum;

@@ -38,6 +38,7 @@ PassPool::PassPool(const RenderSettings& s, const RenderLinks& links, int worker
       done_(size_t(workers), 0),
       progress_(s.progress),
       lastCheckpoint_(std::chrono::steady_clock::now()) {
+  film_.radianceUnit = s.radianceUnit;
   film_.depthUnit = s.depthUnit;
   // A resumed render goes on from the first pass its film lacks; a chunk starts at its first.
   next_ = nextToMerge_ = firstNew_ = uint32_t(film_.nextPass());

@@ -70,8 +70,9 @@ struct RenderSettings {
   // (render/merge_grid.h shrinks it pass by pass).
   float mergeRadius = 0.01f;
   unsigned seed = 1;
-  // The scene file's lengths per renderer length (1 / Scene::worldScale), for the depth layer.
-  double depthUnit = 1.0;
+  // The scene's radiance per renderer radiance (render/radiance_unit.h) and its lengths per
+  // renderer length (1 / Scene::worldScale, for the depth layer): the film's units.
+  double radianceUnit = 1.0, depthUnit = 1.0;
   std::array<float, 3> env{0.f, 0.f, 0.f};  // --env: constant radiance, found by BSDF sampling only
   // --env-map: an HDR map lighting the scene, sampled like the triangle lights; null: none.
   std::shared_ptr<const EnvironmentMap> envMap;
