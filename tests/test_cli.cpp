@@ -326,7 +326,8 @@ TEST(RenderCli, ASceneInAnyUnitsRendersTheSameBits) {
     ASSERT_EQ(base.exitCode, 0) << base.output;
     std::vector<std::string> names;
     const std::vector<float> expected = test::exrChannels(dir + "/1.exr", &names);
-    for (int exponent : {-70, -12, 9, 40, 110}) {
+    // Far below the band, just below it, and far above it (the loader's test covers more).
+    for (int exponent : {-70, -12, 110}) {
       const std::string scaled = test::writeScaledCopy(obj, exponent), out = dir + "/" + std::to_string(exponent) + ".exr";
       const auto r = test::runFredholm("render " + scaled + " --method " + method + aovs + flags + "-o " + out);
       ASSERT_EQ(r.exitCode, 0) << r.output;
@@ -376,7 +377,7 @@ TEST(RenderCli, EmittersOfAnyBrightnessRenderTheSameImageScaled) {
     const std::vector<float> expected = render(method, 20, env), unit = render(method, 0, env);
     ASSERT_FALSE(expected.empty());
     ASSERT_GT(*std::max_element(unit.begin(), unit.end()), 0.f) << method;
-    for (int exponent : {-60, -20, 40, 100}) {
+    for (int exponent : {-60, 100}) {
       const std::vector<float> got = render(method, exponent, env);
       ASSERT_EQ(got.size(), expected.size());
       size_t differing = 0;
