@@ -65,6 +65,9 @@ MUTATIONS = [Mutation(*m) for m in [
      "if (std::abs(exponent) <= 1000) return 1.0;",
      "emission never scaled to the unit (dim scenes below the film's quantum, bright splats capped)",
      r"^RenderCli\.EmittersOfAnyBrightness"),
+    ("texels-unmended", "host/render/device_scene.cpp", "    mendReflectance(rgb, t);\n", "",
+     "float texture texels taken as they are (NaN, negative or above-one reflectance)",
+     r"^RenderCli\.TexelsNoReflectanceCanBe"),
     # Materials.
     ("ggx-pdf", "kernels/bsdf.h", "return select(ggx_g1(wo, a) * ggx_d(h, a) / (4.0f * wo.z),",
      "return select(1.1f * ggx_g1(wo, a) * ggx_d(h, a) / (4.0f * wo.z),", "a 10 % GGX pdf error",

@@ -233,6 +233,45 @@ TEST(RenderCli, AnUnreadableTextureIsAWarningNamingItAndItsMaterial) {
   EXPECT_NE(r.output.find("broken.png"), std::string::npos) << r.output;
 }
 
+// A float texture holds any number; a reflectance cannot: NaN, infinite, negative or above
+// one texels are mended (grey, zero, scaled down as Kd is) with a warning naming them, and
+// the render stays finite with an albedo of at most one.
+TEST(RenderCli, TexelsNoReflectanceCanBeAreMendedWithAWarning) {
+  const std::string dir = test::tempDir("cli");
+  const float texels[4][3] = {{NAN, 0.f, 0.f}, {-1.f, 0.5f, 0.5f}, {4.f, 2.f, 1e30f}, {0.3f, 0.3f, 0.3f}};
+  {
+    auto out = OIIO::ImageOutput::create(dir + "/odd.exr");
+    ASSERT_TRUE(out);
+    ASSERT_TRUE(out->open(dir + "/odd.exr", OIIO::ImageSpec(2, 2, 3, OIIO::TypeDesc::FLOAT)));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, texels));
+    out->close();
+  }
+  test::writeFile(dir + "/t.obj", "mtllib t.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nv -0.3 1.5 -0.3\n"
+                                  "v 0.3 1.5 -0.3\nv 0.3 1.5 0.3\nv -0.3 1.5 0.3\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                                  "usemtl painted\nf 4/4 3/3 2/2 1/1\nusemtl light\nf 5 6 7 8\n");
+  test::writeFile(dir + "/t.mtl", "newmtl painted\nKd 1 1 1\nmap_Kd odd.exr\nnewmtl light\nKe 5 5 5\n");
+  const auto r = test::runFredholm("render " + dir + "/t.obj --width 12 --height 12 --spp 4 --eye 0,1,3 --target "
+                                   "0,0,0 --aovs albedo -o " + dir + "/t.exr");
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("fredholm: warning: material 'painted': texture '"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("1 not finite (made grey), 1 negative (made zero), 1 above one (scaled down to one, "
+                          "hue kept)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("NaN or infinite"), std::string::npos) << r.output;
+  std::vector<std::string> names;
+  const std::vector<float> channels = test::exrChannels(dir + "/t.exr", &names);
+  float albedo = 0.f, radiance = 0.f;
+  for (size_t i = 0; i < channels.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(channels[i])) << names[i % names.size()];
+    if (names[i % names.size()].rfind("albedo.", 0) == 0) albedo = std::max(albedo, channels[i]);
+    else radiance = std::max(radiance, channels[i]);
+  }
+  EXPECT_GT(albedo, 0.f);
+  EXPECT_LE(albedo, 1.f);
+  EXPECT_GT(radiance, 0.f);
+}
+
 // A bench scene that cannot be read is refused before anything is measured: one line that
 // names it and what it needs, no rows, no --json file.
 TEST(BenchCli, AnUnreadableSceneIsOneLineBeforeAnyMeasurement) {

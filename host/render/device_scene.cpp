@@ -5,6 +5,7 @@
 #include <OpenImageIO/imageio.h>
 #endif
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <set>
@@ -158,6 +159,39 @@ std::vector<uint32_t> srgbDecodeTable() {
   return table;
 }
 
+namespace {
+
+// A float texel as a reflectance, counted in t where it was not one (TextureData).
+void mendReflectance(float rgb[3], TextureData& t) {
+  if (!std::isfinite(rgb[0]) || !std::isfinite(rgb[1]) || !std::isfinite(rgb[2])) {
+    rgb[0] = rgb[1] = rgb[2] = 0.5f;
+    ++t.notFinite;
+    return;
+  }
+  if (rgb[0] < 0.f || rgb[1] < 0.f || rgb[2] < 0.f) {
+    for (int c = 0; c < 3; ++c) rgb[c] = std::max(rgb[c], 0.f);
+    ++t.negative;
+  }
+  const float most = std::max({rgb[0], rgb[1], rgb[2]});
+  if (most > 1.f) {
+    for (int c = 0; c < 3; ++c) rgb[c] = std::min(rgb[c] / most, 1.f);
+    ++t.aboveOne;
+  }
+}
+
+// What loadTexture mended, for a warning; empty if nothing.
+std::string mended(const TextureData& t) {
+  std::string out;
+  const std::pair<size_t, const char*> kinds[] = {{t.notFinite, " not finite (made grey)"},
+                                                  {t.negative, " negative (made zero)"},
+                                                  {t.aboveOne, " above one (scaled down to one, hue kept)"}};
+  for (const auto& [count, what] : kinds)
+    if (count) out += (out.empty() ? "" : ", ") + std::to_string(count) + what;
+  return out.empty() ? out : "texels that no reflectance can be: " + out;
+}
+
+}  // namespace
+
 TextureData loadTexture(const std::string& path) {
 #ifndef FREDHOLM_HAVE_OIIO
   throw Error("texture '" + path + "': cannot read it (this build has no OpenImageIO)");
@@ -189,10 +223,10 @@ TextureData loadTexture(const std::string& path) {
   const bool srgb = spec.format.basetype == OIIO::TypeDesc::UINT16;
   t.words.resize(4 * texels);
   for (size_t p = 0; p < texels; ++p) {
-    for (int c = 0; c < 3; ++c) {
-      const float v = pixels[channel(p, c)];
-      t.words[4 * p + size_t(c)] = floatBits(srgb ? srgbToLinear(v) : v);
-    }
+    float rgb[3];
+    for (int c = 0; c < 3; ++c) rgb[c] = srgb ? srgbToLinear(pixels[channel(p, c)]) : pixels[channel(p, c)];
+    mendReflectance(rgb, t);
+    for (int c = 0; c < 3; ++c) t.words[4 * p + size_t(c)] = floatBits(rgb[c]);
     t.words[4 * p + 3] = floatBits(1.f);
   }
   return t;
@@ -232,13 +266,16 @@ PreparedScene prepareScene(const Scene& scene, const Bvh& bvh, const SceneFeatur
     prepared.texels = srgbDecodeTable();
     for (size_t index = 0; index < scene.textures.size(); ++index) {
       const Texture& tex = scene.textures[index];
+      std::string users;
+      for (const Material& m : scene.materials)
+        if (m.kdTexture == int(index)) users += (users.empty() ? "material '" : ", '") + m.name + "'";
       TextureData t;
       try {
         t = loadTexture(tex.path);
+        const std::string repairs = mended(t);
+        if (!repairs.empty())
+          prepared.warnings.push_back(users + ": texture '" + tex.path + "': " + repairs);
       } catch (const Error& e) {
-        std::string users;
-        for (const Material& m : scene.materials)
-          if (m.kdTexture == int(index)) users += (users.empty() ? "material '" : ", '") + m.name + "'";
         prepared.warnings.push_back(users + ": " + e.what() + "; using a grey texel");
         t.width = t.height = 1;
         t.format = TextureData::kLinearFloat;

@@ -64,6 +64,9 @@ struct TextureData {
   int width = 0, height = 0;
   Format format = kLinearFloat;
   std::vector<uint32_t> words;
+  // Texels of a float image that no reflectance can be, as loadTexture mended them: not
+  // finite (grey), negative (zero), above one (scaled down to one, hue kept, as Kd is).
+  size_t notFinite = 0, negative = 0, aboveOne = 0;
 };
 // The linear value of each 8-bit sRGB code, as float bits: the first 256 words of the
 // kernels' texel buffer.
