@@ -121,7 +121,8 @@ TEST(Checkpoint, EverySettingThatChangesTheImageChangesTheFingerprint) {
       {"filter", [](RenderSettings& s) { s.filter = PixelFilter::Gaussian; }},
       {"noise target", [](RenderSettings& s) { s.noise = 1e-3; }},
       {"adaptive", [](RenderSettings& s) { s.adaptive = true; }},
-      {"surface layers", [](RenderSettings& s) { s.surfaceAovs = true; }}};
+      {"surface layers", [](RenderSettings& s) { s.surfaceAovs = true; }},
+      {"radiance unit", [](RenderSettings& s) { s.radianceUnit = 0x1p20; }}};
   for (const auto& [what, change] : changing) {
     RenderSettings s = base;
     change(s);

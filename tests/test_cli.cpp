@@ -361,13 +361,15 @@ TEST(RenderCli, ASceneInAnyUnitsRendersTheSameBits) {
   const std::string flags = " --width 12 --height 10 --spp 4 --seed 5 --force ";
   for (const char* method : {"mis", "vcm"}) {
     const std::string aovs = std::string(method) == "mis" ? " --aovs depth" : "";
-    const auto base = test::runFredholm("render " + obj + " --method " + method + aovs + flags + "-o " + dir + "/1.exr");
+    const auto base =
+        test::runFredholm("render " + obj + " --method " + method + aovs + flags + "-o " + dir + "/1.exr");
     ASSERT_EQ(base.exitCode, 0) << base.output;
     std::vector<std::string> names;
     const std::vector<float> expected = test::exrChannels(dir + "/1.exr", &names);
     // Far below the band, just below it, and far above it (the loader's test covers more).
     for (int exponent : {-70, -12, 110}) {
-      const std::string scaled = test::writeScaledCopy(obj, exponent), out = dir + "/" + std::to_string(exponent) + ".exr";
+      const std::string scaled = test::writeScaledCopy(obj, exponent);
+      const std::string out = dir + "/" + std::to_string(exponent) + ".exr";
       const auto r = test::runFredholm("render " + scaled + " --method " + method + aovs + flags + "-o " + out);
       ASSERT_EQ(r.exitCode, 0) << r.output;
       EXPECT_EQ(r.output.find("warning"), base.output.find("warning")) << r.output;

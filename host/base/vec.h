@@ -2,6 +2,7 @@
 #pragma once
 #include <array>
 #include <cmath>
+#include <cstdlib>
 
 namespace fh {
 
@@ -22,6 +23,16 @@ inline float3 minv(const float3& a, const float3& b) {
 }
 inline float3 maxv(const float3& a, const float3& b) {
   return {std::fmax(a[0], b[0]), std::fmax(a[1], b[1]), std::fmax(a[2], b[2])};
+}
+
+// The exponent of the power of two (an exact scaling) that brings `magnitude` into [1, 2),
+// or 0 where its own exponent is within `band` of zero already, or it is zero or not finite:
+// how scenes far from unit size or brightness are brought near it (Scene::worldScale,
+// render/radiance_unit.h).
+inline int exponentTowardOne(double magnitude, int band) {
+  if (!(magnitude > 0.0) || !std::isfinite(magnitude)) return 0;
+  const int exponent = std::ilogb(magnitude);
+  return std::abs(exponent) <= band ? 0 : -exponent;
 }
 
 }  // namespace fh

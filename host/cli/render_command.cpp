@@ -448,7 +448,8 @@ std::map<std::string, std::string> imageMetadata(const RenderOptions& o, const S
       {"device", r.stats.contributors()}, {"seed", o.seed},     {"seconds", formatSeconds(seconds)},
       {"filter", o.filter},              {"max_depth", std::to_string(o.maxDepth)}};
   if (!o.aovs.empty()) metadata["aovs"] = o.aovs;
-  if (method == "vcm") metadata["merge_radius"] = formatScientific(o.mergeRadius.value_or(RenderSettings{}.mergeRadius));
+  if (method == "vcm")
+    metadata["merge_radius"] = formatScientific(o.mergeRadius.value_or(RenderSettings{}.mergeRadius));
   if (!o.envMap.empty()) {
     metadata["env_map"] = o.envMap;
     metadata["env_rotate"] = formatSeconds(o.envRotate.value_or(0.f));

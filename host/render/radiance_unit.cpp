@@ -5,20 +5,27 @@
 #include <cmath>
 #include <memory>
 
+#include "base/vec.h"
 #include "scene/environment_map.h"
 
 namespace fh {
 namespace {
 
-// Emitters as bright as 2^-kRadianceBand to 2^kRadianceBand render in the scene's units.
+// Emitters whose brightness has an exponent within kRadianceBand of zero render in the
+// scene's units (exponentTowardOne).
 constexpr int kRadianceBand = 10;
+
+// A light's Ke.
+const Vec3f& emission(const Scene& scene, const Light& light) {
+  return scene.materials[size_t(scene.triangleMaterial[light.triangle])].ke;
+}
 
 // The brightest emission: a light's Ke, --env, or --env-map's mean radiance (its texels'
 // largest would let a sun disk set the unit for a dim sky).
 double brightest(const Scene& scene, const RenderSettings& s) {
   double most = 0.0;
   for (const Light& light : scene.lights)
-    for (float ke : scene.materials[size_t(scene.triangleMaterial[light.triangle])].ke) most = std::max(most, double(ke));
+    for (float ke : emission(scene, light)) most = std::max(most, double(ke));
   for (float e : s.env) most = std::max(most, double(e));
   if (s.envMap) most = std::max(most, s.envMap->luminanceIntegral / (4.0 * M_PI));
   return most;
@@ -36,21 +43,17 @@ EnvironmentMap scaledMap(const EnvironmentMap& map, float factor) {
 }  // namespace
 
 double toRadianceUnit(Scene& scene, RenderSettings& s) {
-  const double most = brightest(scene, s);
-  if (!(most > 0.0) || !std::isfinite(most)) return 1.0;
-  const int exponent = std::clamp(std::ilogb(most), -126, 126);  // a float's normal exponents
-  if (std::abs(exponent) <= kRadianceBand) return 1.0;
-  const float factor = std::ldexp(1.f, -exponent);
+  // Clamped to a float's normal exponents, so that the factor is a normal float.
+  const int exponent = std::clamp(exponentTowardOne(brightest(scene, s), kRadianceBand), -126, 126);
+  if (exponent == 0) return 1.0;
+  const float factor = std::ldexp(1.f, exponent);
   for (Material& m : scene.materials)
     for (float& ke : m.ke) ke *= factor;
-  for (Light& light : scene.lights) {  // as collectLights has it, from the scaled Ke (exact)
-    const Vec3f& ke = scene.materials[size_t(scene.triangleMaterial[light.triangle])].ke;
-    const float k = float(M_PI) * light.area;
-    light.power = {k * ke[0], k * ke[1], k * ke[2]};
-  }
+  for (Light& light : scene.lights)  // from the scaled Ke: exact, and finite where the file's overflowed
+    light.power = emittedPower(light.area, emission(scene, light));
   for (float& e : s.env) e *= factor;
   if (s.envMap) s.envMap = std::make_shared<const EnvironmentMap>(scaledMap(*s.envMap, factor));
-  return std::ldexp(1.0, exponent);
+  return std::ldexp(1.0, -exponent);
 }
 
 }  // namespace fh

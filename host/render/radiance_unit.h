@@ -2,7 +2,7 @@
 // merges, render/film.h) and light paths' splats are capped at 2^24: at unit brightness
 // that spans any image, but a scene lit by emitters of 1e-5 (every sample a fraction of a
 // quantum) renders black, and one lit by the sun's 1e9 has its caustics capped. So a scene
-// whose brightest emitter lies outside 2^-10 to 2^10 has its emission scaled into [1, 2) by
+// whose brightest emitter lies outside [2^-10, 2^11) has its emission scaled into [1, 2) by
 // a power of two before it renders, and the film scales each pass back as it adds it: the
 // same arithmetic as for a scene of unit brightness (every estimator is linear in the
 // emission), exact, and the film in the scene's own units.

@@ -2,6 +2,7 @@
 // kernels and the tests consume.
 #pragma once
 #include <array>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -37,8 +38,14 @@ struct Texture {
 struct Light {
   unsigned triangle = 0;
   float area = 0.f;
-  Vec3f power{0.f, 0.f, 0.f};  // pi * area * Ke: a one-sided Lambertian emitter
+  Vec3f power{0.f, 0.f, 0.f};  // emittedPower(area, Ke)
 };
+
+// The power of a one-sided Lambertian emitter of radiance ke over `area`: pi * area * Ke.
+inline Vec3f emittedPower(float area, const Vec3f& ke) {
+  const float k = float(M_PI) * area;
+  return {k * ke[0], k * ke[1], k * ke[2]};
+}
 
 struct Scene {
   std::string sourcePath;

@@ -123,8 +123,8 @@ void checkIndices(const std::string& objName, const tinyobj::attrib_t& attrib,
   }
 }
 
-// Scenes whose size (the largest side of the box around their faces' vertices) lies within
-// [2^-kWorldScaleBand, 2^kWorldScaleBand] keep their units; others are scaled by a power of
+// Scenes whose size (the largest side of the box around their faces' vertices) has an
+// exponent within kWorldScaleBand of zero keep their units; others are scaled by a power of
 // two to a size in [1, 2), never so far that a coordinate would pass 2^kMaxScaledExponent.
 constexpr int kWorldScaleBand = 10;
 constexpr int kMaxScaledExponent = 100;
@@ -141,24 +141,23 @@ float scaleToWorld(std::vector<float>& positions, const std::vector<tinyobj::sha
         magnitude = std::max(magnitude, std::fabs(v));
       }
   const double size = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
-  if (!(size > 0.0) || !std::isfinite(size) || !(magnitude > 0.0)) return 1.f;  // the lint's and BVH's to refuse
-  if (size >= std::ldexp(1.0, -kWorldScaleBand) && size <= std::ldexp(1.0, kWorldScaleBand)) return 1.f;
-  const int exponent = std::min(-std::ilogb(size), kMaxScaledExponent - std::ilogb(magnitude));
+  // A scene of no size or of non-finite size is the lint's and the BVH's to refuse.
+  int exponent = exponentTowardOne(size, kWorldScaleBand);
+  if (exponent == 0) return 1.f;
+  exponent = std::min(exponent, kMaxScaledExponent - std::ilogb(magnitude));
   for (float& p : positions) p = std::ldexp(p, exponent);
   return std::ldexp(1.f, exponent);
 }
 
 // A triangle's three corner normals scaled alike by a power of two (exact: their
-// interpolation keeps its direction) where their largest component lies outside
-// [2^-kWorldScaleBand, 2^kWorldScaleBand], to one in [1, 2): the kernels normalize the
+// interpolation keeps its direction) where their largest component is as far from one as a
+// scene's size that the loader scales, to one in [1, 2): the kernels normalize the
 // interpolated normal through its square, which must neither over- nor underflow.
 void bringNearUnitLength(float* normals) {
   float largest = 0.f;
   for (int i = 0; i < 9; ++i) largest = std::max(largest, std::fabs(normals[i]));
-  if (!(largest > 0.f) || !std::isfinite(largest)) return;
-  const int exponent = std::ilogb(largest);
-  if (std::abs(exponent) <= kWorldScaleBand) return;
-  for (int i = 0; i < 9; ++i) normals[i] = std::ldexp(normals[i], -exponent);
+  const int exponent = exponentTowardOne(largest, kWorldScaleBand);
+  for (int i = 0; exponent != 0 && i < 9; ++i) normals[i] = std::ldexp(normals[i], exponent);
 }
 
 void flattenShapes(Scene& scene, const tinyobj::attrib_t& attrib, const std::vector<tinyobj::shape_t>& shapes,
@@ -258,8 +257,7 @@ void collectLights(Scene& scene) {
       ++zeroArea;
       continue;
     }
-    const float k = float(M_PI) * area;
-    scene.lights.push_back({unsigned(t), area, {k * m.ke[0], k * m.ke[1], k * m.ke[2]}});
+    scene.lights.push_back({unsigned(t), area, emittedPower(area, m.ke)});
   }
   if (zeroArea)
     scene.warnings.push_back(std::to_string(zeroArea) + " emissive triangle(s) have zero area and emit nothing");

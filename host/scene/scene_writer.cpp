@@ -62,7 +62,8 @@ std::string mtlText(const Scene& scene, const fs::path& mtlDir) {
 std::string objText(const Scene& scene, const std::string& mtlName) {
   std::ostringstream out = textWriter();
   out << "# written by fredholm export from " << scene.sourcePath << "\nmtllib " << mtlName << '\n';
-  for (size_t v = 0; v < scene.vertexCount(); ++v) writeTriple(out, "v", scene.vertex(unsigned(v)) * (1.f / scene.worldScale));  // in the file's units
+  const float toFile = 1.f / scene.worldScale;  // vertices in the file's units
+  for (size_t v = 0; v < scene.vertexCount(); ++v) writeTriple(out, "v", scene.vertex(unsigned(v)) * toFile);
   const bool normals = !scene.cornerNormals.empty(), uvs = !scene.cornerUVs.empty();
   for (size_t c = 0; normals && c < scene.cornerNormals.size(); c += 3)
     out << "vn " << scene.cornerNormals[c] << ' ' << scene.cornerNormals[c + 1] << ' ' << scene.cornerNormals[c + 2]
