@@ -286,8 +286,8 @@ FH_INLINE int unoccluded(const SceneView* scene, lvec3 a, lvec3 b, LightTally* t
 
 // s = 1: a point uniform in the area of a light triangle picked by the light table.
 FH_INLINE lvec3 connect_to_triangle(RenderParams params, const SceneView* scene, MergeFactors m, const CameraVertex* c,
-                                    float u_pick, float u1, float u2, LightTally* tally) {
-  const int light = scene->light_triangle[pick_light(scene->light_cdf, params.light_count, u_pick)];
+                                    uint pick, float u1, float u2, LightTally* tally) {
+  const int light = scene->light_triangle[pick];
   const lvec2 b = sample_triangle(u1, u2);
   const SurfacePoint y = surface_point(scene->triangles, light, b.x, b.y);
   const float pdf_area = scene->light_pdf_area[light];
@@ -339,12 +339,17 @@ FH_INLINE lvec3 connect_to_environment(RenderParams params, const SceneView* sce
 
 // s = 1: the light table's pick decides between the map and a triangle.
 FH_INLINE lvec3 connect_to_light(RenderParams params, const SceneView* scene, MergeFactors m, float4 sphere,
-                                 const CameraVertex* c, float u_pick, float u1, float u2, LightTally* tally) {
+                                 const CameraVertex* c, lvec2 u, float u_narrow, LightTally* tally) {
   (void)sphere;  // read with FH_ENV_MAP only
 #if defined(FH_ENV_MAP)
-  if (u_pick < params.env_pick) return connect_to_environment(params, scene, m, sphere, c, u1, u2, tally);
+  if (u.y < params.env_pick)
+    return connect_to_environment(params, scene, m, sphere, c, u.x,
+                                  params.env_pick < FH_NARROW_SHARE ? u_narrow : within_share(u.y, 0.0f, params.env_pick),
+                                  tally);
 #endif
-  return params.light_count > 0u ? connect_to_triangle(params, scene, m, c, u_pick, u1, u2, tally) : v3_splat(0.0f);
+  if (params.light_count == 0u) return v3_splat(0.0f);
+  const LightPick pick = pick_light_within(scene->light_cdf, params.light_count, params.env_pick, u.y);
+  return connect_to_triangle(params, scene, m, c, pick.light, u.x, pick.narrow ? u_narrow : pick.within, tally);
 }
 
 // s >= 2: the camera vertex joined to a stored light vertex.
@@ -544,8 +549,8 @@ FH_INLINE lvec3 trace_camera_subpath(RenderParams params, const SceneView* scene
     const luint dim = (c.scatterings - 1u) * FH_DIMS_PER_BOUNCE;
     if (bsdf_has_smooth_lobe(&c.v.bsdf)) {
       const lvec2 u = sample_2d(&sampler, dim + FH_DIM_LIGHT_U1);
-      sum = v3_add(sum, connect_to_light(params, scene, m, sphere, &c, sample_1d(&sampler, dim + FH_DIM_LIGHT_PICK),
-                                         u.x, u.y, tally));
+      sum = v3_add(sum, connect_to_light(params, scene, m, sphere, &c, u, sample_1d(&sampler, dim + FH_DIM_LIGHT_NARROW),
+                                         tally));
       for (uint k = 0u; k < light_vertices; ++k) {
         __global const float4* s = own + FH_BDPT_VERTEX_WORDS * k;
         if (c.scatterings + (uint)s[2].w > params.max_depth) break;  // stored in order of scatterings

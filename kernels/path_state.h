@@ -39,7 +39,9 @@
 #define FH_DIM_BSDF_U1 0
 #define FH_DIM_BSDF_U2 1
 #define FH_DIM_ROULETTE 2
-#define FH_DIM_LIGHT_PICK 3
+// The light sample's U2 also picks the light (lights.h); LIGHT_NARROW replaces U2 for
+// the point where the picked light's share of the table is too narrow to stretch.
+#define FH_DIM_LIGHT_NARROW 3
 #define FH_DIM_LIGHT_U1 4
 #define FH_DIM_LIGHT_U2 5
 #define FH_DIM_BSDF_LOBE 6

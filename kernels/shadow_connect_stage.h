@@ -34,12 +34,10 @@ typedef struct {
 
 // A point on an emissive triangle picked by the light table: uniform in the solid
 // angle it subtends where light_seen_from chooses that, else uniform in area.
-FH_INLINE LightSample sample_light_triangle(lvec3 origin, lfloat u_pick, lvec2 u, __global const float4* triangles,
+FH_INLINE LightSample sample_light_triangle(lvec3 origin, luint light, lvec2 u, __global const float4* triangles,
                                             __global const int* triangle_material,
-                                            __global const GpuMaterial* materials, __global const float* light_cdf,
-                                            uint light_count, __global const int* light_triangle,
+                                            __global const GpuMaterial* materials, __global const int* light_triangle,
                                             __global const float* light_pdf_area) {
-  const luint light = pick_light(light_cdf, light_count, u_pick);
   const lint lt = gather_int(light_triangle, light);
   const LightTriangle light_tri = light_triangle_from(triangles, lt, gather_float(light_pdf_area, las_uint(lt)), origin);
   lvec2 b = sample_triangle(u.x, u.y);
@@ -102,23 +100,37 @@ FH_INLINE void connect_light(RenderParams params, const ShadowRequest* r, const 
   // both strategies then see the same geometry, and their MIS weights sum to one even
   // where the offset is a visible distance (far from the origin).
   const lvec3 origin = offset_ray_origin(&s, s.normal);
-  // The pick: the environment map below params.env_pick, a triangle by the light CDF
-  // (whose entries start at env_pick) above.
-  const lfloat u_pick = sample_1d(sampler, dim + FH_DIM_LIGHT_PICK);
+  // The pick, by u.y (lights.h): the environment map below params.env_pick, a triangle by
+  // the light CDF (whose entries start at env_pick) above.
   const lvec2 u = sample_2d(sampler, dim + FH_DIM_LIGHT_U1);
+  LightPick pick;
+  pick.light = (luint)(0u);
+  pick.within = (lfloat)(0.0f);
+  pick.narrow = lanes_mask(false);
+  lmask to_environment = lanes_mask(false);
+#if defined(FH_ENV_MAP)
+  to_environment = u.y < params.env_pick;
+  pick.within = within_share(u.y, 0.0f, params.env_pick);
+  pick.narrow = to_environment && params.env_pick < FH_NARROW_SHARE;
+#endif
+  if (params.light_count > 0 && lanes_any(active && !to_environment)) {
+    const LightPick by_table = pick_light_within(scene->light_cdf, params.light_count, params.env_pick, u.y);
+    pick.light = by_table.light;
+    pick.within = select(by_table.within, pick.within, to_environment);
+    pick.narrow = select(by_table.narrow, pick.narrow, to_environment);
+  }
+  if (lanes_any(active && pick.narrow))
+    pick.within = select(pick.within, sample_1d(sampler, dim + FH_DIM_LIGHT_NARROW), pick.narrow);
+  const lvec2 u_point = lv2(u.x, pick.within);
   LightSample ls;
   ls.wi = ls.radiance = ls.shadow_direction = v3_splat(0.0f);
   ls.pdf = ls.shadow_distance = (lfloat)(0.0f);
-  lmask to_environment = lanes_mask(false);
-#if defined(FH_ENV_MAP)
-  to_environment = u_pick < params.env_pick;
-#endif
   if (params.light_count > 0 && lanes_any(active && !to_environment))
-    ls = sample_light_triangle(origin, u_pick, u, scene->triangles, scene->triangle_material, scene->materials,
-                               scene->light_cdf, params.light_count, scene->light_triangle, scene->light_pdf_area);
+    ls = sample_light_triangle(origin, pick.light, u_point, scene->triangles, scene->triangle_material,
+                               scene->materials, scene->light_triangle, scene->light_pdf_area);
 #if defined(FH_ENV_MAP)
   if (lanes_any(active && to_environment))
-    ls = select_light_sample(to_environment, sample_light_environment(params, u, scene->env_map), ls);
+    ls = select_light_sample(to_environment, sample_light_environment(params, u_point, scene->env_map), ls);
 #endif
   const lfloat cos_surface = v3_dot(n, ls.wi);
   // Behind the surface (by either normal: no light leaks through), or no sample.
