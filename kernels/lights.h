@@ -16,26 +16,16 @@ FH_INLINE luint pick_light(__global const float* cdf, uint count, lfloat u) {
   return search_cdf(cdf, (luint)(0u), count, u);
 }
 
-// Light sampling takes the light and the point on it from one 2D sample: its second
-// coordinate picks the light by the table, and where it fell within that light's share
-// [lo, hi) of the table, stretched to [0, 1), is the point's second coordinate. A
-// stratified set of samples then stays stratified over the lights taken together, where
-// a pick of its own would leave each light a random subset of the points. A share
-// narrower than FH_NARROW_SHARE keeps too few of the coordinate's bits (a float has 24)
-// to place a point, so there the caller draws that coordinate on its own.
-#ifndef FH_NARROW_SHARE  // a test hook may set it (host/base/test_hooks.h)
-#define FH_NARROW_SHARE (1.0f / 64.0f)
-#endif
-
+// Light sampling takes the light and the point on it from one 2D sample (sampling.h,
+// within_share): its second coordinate picks the light by the table, and where it fell
+// within that light's share of the table is the point's second coordinate. A stratified
+// set of samples then stays stratified over the lights taken together, where a pick of
+// its own would leave each light a random subset of the points.
 typedef struct {
   luint light;    // its index in the table
   lfloat within;  // where u fell within its share, in [0, 1)
   lmask narrow;   // the share is too narrow for `within` to be used
 } LightPick;
-
-FH_INLINE lfloat within_share(lfloat u, lfloat lo, lfloat hi) {
-  return clamp((u - lo) / (hi - lo), 0.0f, 0x1.fffffep-1f);
-}
 
 // The table's entries start at `start` (the environment map's share lies below it).
 FH_INLINE LightPick pick_light_within(__global const float* cdf, uint count, float start, lfloat u) {

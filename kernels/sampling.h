@@ -76,6 +76,22 @@ FH_INLINE luint search_cdf(__global const float* cdf, luint first, uint count, l
   return min(base + above, (luint)(count - 1));
 }
 
+// One coordinate of a 2D sample can make a discrete choice (a light) and then, where
+// it fell within the chosen option's share [lo, hi), stretched to [0, 1), still serve the
+// continuous sample that follows: a stratified set of 2D samples then stays stratified
+// over the options taken together, where a choice by a number of its own leaves each
+// option a random subset of the points. A share narrower than FH_NARROW_SHARE keeps too
+// few of the coordinate's bits (a float has 24) to stretch, so there the caller draws the
+// coordinate on its own. A test hook may set FH_NARROW_SHARE to 2, so every share counts
+// as narrow (host/base/test_hooks.h).
+#ifndef FH_NARROW_SHARE
+#define FH_NARROW_SHARE (1.0f / 64.0f)
+#endif
+
+FH_INLINE lfloat within_share(lfloat u, lfloat lo, lfloat hi) {
+  return clamp((u - lo) / (hi - lo), 0.0f, 0x1.fffffep-1f);
+}
+
 // Barycentrics (b1, b2) of a uniform point on a triangle.
 FH_INLINE lvec2 sample_triangle(lfloat u1, lfloat u2) {
   const lfloat su = sqrt(u1);

@@ -809,48 +809,60 @@ TEST(LightPicking, UnequalLightsMatchLambertsFormula) {
   }
 }
 
+// An image's variance from seed to seed (half the squared difference of two seeds'
+// images: the estimator's own, whatever the sampler's stratification) and the film's
+// estimate of it, which takes the samples as independent; both summed over the `counted`
+// pixels and three pairs of seeds. `mean`: the counted pixels' mean over all six images.
+struct ImageVariance {
+  double seedToSeed = 0, asIndependent = 0, mean = 0;
+};
+
+ImageVariance imageVariance(const Scene& scene, const Camera& camera, RenderSettings s,
+                            const std::function<bool(size_t)>& counted) {
+  ImageVariance v;
+  size_t n = 0;
+  for (unsigned pair : {0u, 1u, 2u}) {
+    s.seed = 2 * pair + 1;
+    const RenderResult a = test::render(scene, camera, s);
+    s.seed = 2 * pair + 2;
+    const RenderResult b = test::render(scene, camera, s);
+    for (size_t p = 0; p < size_t(s.width * s.height); ++p)
+      if (counted(p)) {
+        v.seedToSeed += 0.5 * std::pow(luminanceMean(a.film, p) - luminanceMean(b.film, p), 2);
+        v.asIndependent += 0.5 * (pixelVariance(a.film, p) + pixelVariance(b.film, p));
+        v.mean += luminanceMean(a.film, p) + luminanceMean(b.film, p);
+        n += 2;
+      }
+  }
+  v.mean /= double(n);
+  return v;
+}
+
 // One 2D sample picks the light and places the point on it (kernels/lights.h), so a
 // stratified set of samples stays stratified over the emitter's two triangles. On the plane
 // under the rectangular emitter, lit directly, the image follows Lambert's formula, and its
-// variance (half the squared difference of two seeds' images, whatever the stratification)
-// is compared with two others: the film's estimate, which takes the samples as independent
-// (measured: the variance is a tenth of it), and the same render with the point placed by a
-// dimension of its own (the test hook; what lights with a narrow share get), each triangle's
-// points then a random subset (measured: 0.45 times its variance, at 64 and 256 spp).
+// variance is compared with the film's estimate (measured: a tenth of it) and with the
+// variance when the point is placed by a dimension of its own (the test hook; what lights
+// with a narrow share get), each triangle's points a random subset (measured: 0.45 of it,
+// at 64 and 256 spp).
 TEST(LightPicking, OneSampleForThePickAndThePointLowersTheVariance) {
   const Scene scene = PlaneUnderLight::scene();
   const int size = 24;
   const Image exact = PlaneUnderLight::reference(scene.camera, size, size, 8, true);
   const auto expected = [&](size_t p) { return double(exact.rgb[3 * p]); };
+  const auto onThePlane = [&](size_t p) { return !std::isnan(expected(p)); };
   RenderSettings s = test::renderSettings();
   s.method = Method::NEE;
   s.width = s.height = size;
   s.spp = 64;
   s.maxDepth = 1;
-  struct Variance {
-    double seedToSeed = 0, asIndependent = 0;  // summed over pixels and three pairs of seeds
-  };
-  const auto variance = [&](const std::string& what) {
-    Variance v;
-    for (unsigned pair : {0u, 1u, 2u}) {
-      s.seed = 2 * pair + 1;
-      const RenderResult a = test::render(scene, scene.camera, s);
-      s.seed = 2 * pair + 2;
-      const RenderResult b = test::render(scene, scene.camera, s);
-      if (pair == 0) expectMatches(a.film, expected, what);
-      for (size_t p = 0; p < size_t(size * size); ++p)
-        if (!std::isnan(expected(p))) {
-          v.seedToSeed += 0.5 * std::pow(luminanceMean(a.film, p) - luminanceMean(b.film, p), 2);
-          v.asIndependent += 0.5 * (pixelVariance(a.film, p) + pixelVariance(b.film, p));
-        }
-    }
-    return v;
-  };
-  const Variance together = variance("pick and point from one sample");
+  expectMatches(test::render(scene, scene.camera, s).film, expected, "pick and point from one sample");
+  const ImageVariance together = imageVariance(scene, scene.camera, s, onThePlane);
   TestHooks hooks = testHooks();
-  hooks.lightPointApart = true;
-  const ScopedTestHooks pointApart(hooks);
-  const Variance apart = variance("the point by a dimension of its own");
+  hooks.everyShareNarrow = true;
+  const ScopedTestHooks apartHook(hooks);
+  expectMatches(test::render(scene, scene.camera, s).film, expected, "the point by a dimension of its own");
+  const ImageVariance apart = imageVariance(scene, scene.camera, s, onThePlane);
   EXPECT_LT(together.seedToSeed, 0.15 * together.asIndependent)
       << "variance " << together.seedToSeed << ", the film's estimate " << together.asIndependent;
   EXPECT_LT(together.seedToSeed, 0.65 * apart.seedToSeed)

@@ -42,10 +42,10 @@ struct TestHooks {
   bool vcmMergeOnly = false;
 
   // In-process only: light sampling places the point on the picked light by a dimension of
-  // its own for every light, as it does where a light's share of the table is narrow
-  // (kernels/lights.h, FH_NARROW_SHARE), so that a test can measure what drawing the pick
-  // and the point from one 2D sample gains. Used by tests/test_path_tracer.cpp.
-  bool lightPointApart = false;
+  // its own for every light, as where the light's share of the table is narrow
+  // (kernels/sampling.h, FH_NARROW_SHARE), so that a test can measure what drawing the
+  // pick and the point from one 2D sample gains. Used by tests/test_path_tracer.cpp.
+  bool everyShareNarrow = false;
 };
 
 // The hooks, parsed from the environment on first use. A malformed value is an Error that

@@ -57,7 +57,7 @@ ProgramSpec pathTracerProgram(const SceneFeatures& features, Method method, cons
           mega ? std::vector<std::string>{stageInfo(Stage::PlanIteration).file, kMegakernel.file} : stageFiles(),
           traversalOptions + features.buildOptions() + " -DFH_METHOD_" + methodFlag +
               " -DFH_LANES=" + std::to_string(lanesOf(strategy)) + (mega ? " -DFH_MEGAKERNEL" : "") +
-              (surfaceAovs ? " -DFH_AOVS" : "") + (testHooks().lightPointApart ? " -DFH_NARROW_SHARE=2.0f" : "")};
+              (surfaceAovs ? " -DFH_AOVS" : "") + (testHooks().everyShareNarrow ? " -DFH_NARROW_SHARE=2.0f" : "")};
 }
 
 Strategy strategyFor(const DeviceInfo& device, Strategy asked) {
