@@ -1,8 +1,8 @@
 // Per-pixel low-discrepancy samples for the path's random decisions.
 //
 // The samples of one pixel (its passes 0, 1, 2, ...) take their 2D decisions (sub-pixel
-// position, BSDF direction, point on a light) from the Sobol' (0,2)-sequence in base 2 and
-// their 1D ones (lobe, roulette, light choice) from the van der Corput sequence, so that any
+// position, BSDF direction, point on a light and the light's pick) from the Sobol' (0,2)-sequence in base 2 and
+// their 1D ones (lobe, roulette) from the van der Corput sequence, so that any
 // 2^k of them stratify their square or interval. Each pixel and each dimension pair gets its own random
 // Owen scrambling (every point still uniform: the estimator stays unbiased) and its own
 // shuffle of the sample order (so pairs of dimensions are not correlated with each other):
