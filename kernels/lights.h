@@ -16,11 +16,8 @@ FH_INLINE luint pick_light(__global const float* cdf, uint count, lfloat u) {
   return search_cdf(cdf, (luint)(0u), count, u);
 }
 
-// Light sampling takes the light and the point on it from one 2D sample (sampling.h,
-// within_share): its second coordinate picks the light by the table, and where it fell
-// within that light's share of the table is the point's second coordinate. A stratified
-// set of samples then stays stratified over the lights taken together, where a pick of
-// its own would leave each light a random subset of the points.
+// Light sampling picks the light by its 2D sample's second coordinate, which, stretched
+// within the light's share of the table (sampling.h, within_share), then places the point.
 typedef struct {
   luint light;    // its index in the table
   lfloat within;  // where u fell within its share, in [0, 1)

@@ -811,16 +811,15 @@ TEST(LightPicking, UnequalLightsMatchLambertsFormula) {
 
 // An image's variance from seed to seed (half the squared difference of two seeds'
 // images: the estimator's own, whatever the sampler's stratification) and the film's
-// estimate of it, which takes the samples as independent; both summed over the `counted`
-// pixels and three pairs of seeds. `mean`: the counted pixels' mean over all six images.
-struct ImageVariance {
-  double seedToSeed = 0, asIndependent = 0, mean = 0;
+// estimate of it, which takes the samples as independent (imageVariance's sum); both over
+// the `counted` pixels and three pairs of seeds.
+struct SeedVariance {
+  double seedToSeed = 0, asIndependent = 0;
 };
 
-ImageVariance imageVariance(const Scene& scene, const Camera& camera, RenderSettings s,
-                            const std::function<bool(size_t)>& counted) {
-  ImageVariance v;
-  size_t n = 0;
+SeedVariance seedToSeedVariance(const Scene& scene, const Camera& camera, RenderSettings s,
+                                const std::function<bool(size_t)>& counted) {
+  SeedVariance v;
   for (unsigned pair : {0u, 1u, 2u}) {
     s.seed = 2 * pair + 1;
     const RenderResult a = test::render(scene, camera, s);
@@ -830,11 +829,8 @@ ImageVariance imageVariance(const Scene& scene, const Camera& camera, RenderSett
       if (counted(p)) {
         v.seedToSeed += 0.5 * std::pow(luminanceMean(a.film, p) - luminanceMean(b.film, p), 2);
         v.asIndependent += 0.5 * (pixelVariance(a.film, p) + pixelVariance(b.film, p));
-        v.mean += luminanceMean(a.film, p) + luminanceMean(b.film, p);
-        n += 2;
       }
   }
-  v.mean /= double(n);
   return v;
 }
 
@@ -857,12 +853,12 @@ TEST(LightPicking, OneSampleForThePickAndThePointLowersTheVariance) {
   s.spp = 64;
   s.maxDepth = 1;
   expectMatches(test::render(scene, scene.camera, s).film, expected, "pick and point from one sample");
-  const ImageVariance together = imageVariance(scene, scene.camera, s, onThePlane);
+  const SeedVariance together = seedToSeedVariance(scene, scene.camera, s, onThePlane);
   TestHooks hooks = testHooks();
   hooks.everyShareNarrow = true;
   const ScopedTestHooks apartHook(hooks);
   expectMatches(test::render(scene, scene.camera, s).film, expected, "the point by a dimension of its own");
-  const ImageVariance apart = imageVariance(scene, scene.camera, s, onThePlane);
+  const SeedVariance apart = seedToSeedVariance(scene, scene.camera, s, onThePlane);
   EXPECT_LT(together.seedToSeed, 0.15 * together.asIndependent)
       << "variance " << together.seedToSeed << ", the film's estimate " << together.asIndependent;
   EXPECT_LT(together.seedToSeed, 0.65 * apart.seedToSeed)

@@ -41,8 +41,8 @@ struct TestHooks {
   // estimator can be tested alone. Used by tests/test_path_tracer.cpp.
   bool vcmMergeOnly = false;
 
-  // In-process only: light sampling places the point on the picked light by a dimension of
-  // its own for every light, as where the light's share of the table is narrow
+  // In-process only: the path tracer's light sampling (nee, mis) places the point on the
+  // picked light by a dimension of its own for every light, as where its share is narrow
   // (kernels/sampling.h, FH_NARROW_SHARE), so that a test can measure what drawing the
   // pick and the point from one 2D sample gains. Used by tests/test_path_tracer.cpp.
   bool everyShareNarrow = false;

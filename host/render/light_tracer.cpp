@@ -33,7 +33,6 @@ ProgramSpec lightTracerProgram(Method method, const SceneFeatures& features, con
   const int only = testHooks().bdptOnlyLightVertices;
   std::string strategy = joined && only >= 0 ? " -DFH_BDPT_ONLY_S=" + std::to_string(only) + "u" : "";
   if (vcm) strategy += testHooks().vcmMergeOnly ? " -DFH_VCM -DFH_VCM_MERGE_ONLY" : " -DFH_VCM";
-  if (testHooks().everyShareNarrow) strategy += " -DFH_NARROW_SHARE=2.0f";
   return {std::string(joined ? "bidirectional path tracer (" : "light tracer (") + methodName(method) +
               features.buildOptions() + strategy + ")",
           {joined ? "bdpt.cl" : "light_trace.cl"}, traversalOptions + features.buildOptions() + strategy + " -DFH_LANES=1"};
