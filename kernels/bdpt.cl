@@ -212,7 +212,7 @@ FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, 
     const TraceHit hit = trace_ray(scene->nodes, scene->blocks, (float3)(org.x, org.y, org.z),
                                    (float3)(dir.x, dir.y, dir.z), 0.0f, INFINITY);
     if (hit.triangle < 0) break;
-    const LightVertex v = light_vertex(scene, hit);
+    const LightVertex v = light_vertex(scene, hit.triangle, hit.b1, hit.b2);
     const lvec3 w_in = v3_neg(dir);
     const float cos_g_in = v3_dot(v.point.normal, w_in);
     if (cos_g_in == 0.0f) break;
@@ -240,12 +240,13 @@ FH_INLINE uint trace_light_subpath(RenderParams params, const SceneView* scene, 
         const float weight = strategy_weight(1.0f / (1.0f + w_light), scatterings + 1u, scatterings);
         connect_to_camera(params, scene, &view,
                           v3_scale(v3_mul(alpha, f), fabs(v3_dot(n, w_in)) * cos_camera / fabs(cos_g_in) * weight),
-                          splats, density, tally);
+                          lanes_mask(true), splats, density, tally);
       }
     }
     if (scatterings == params.max_depth) break;
 
-    const BsdfSample s = bounce_light_path(params, &v, n, w_in, scatterings, stream, path, &dim, &alpha, &carried);
+    const BsdfSample s =
+        bounce_light_path(params, &v, n, w_in, lanes_mask(true), scatterings, stream, path, &dim, &alpha, &carried);
     if (s.pdf == 0.0f) break;
     const float pdf_rev = s.pdf > 0.0f ? bsdf_pdf(&v.bsdf, n, s.wi, w_in) : 0.0f;
     const float cos_out = fabs(v3_dot(v.point.normal, s.wi));
@@ -361,7 +362,7 @@ FH_INLINE lvec3 connect_vertices(const SceneView* scene, MergeFactors m, const C
   hit.b1 = s0.y;
   hit.b2 = s0.z;
   hit.t = 0.0f;
-  const LightVertex l = light_vertex(scene, hit);
+  const LightVertex l = light_vertex(scene, hit.triangle, hit.b1, hit.b2);
   const lvec3 w_in = v3(s1.x, s1.y, s1.z), alpha = v3(s2.x, s2.y, s2.z);
   const float cos_l_in = v3_dot(l.point.normal, w_in);
   const lvec3 g_l = cos_l_in > 0.0f ? l.point.normal : v3_neg(l.point.normal);
@@ -523,7 +524,7 @@ FH_INLINE lvec3 trace_camera_subpath(RenderParams params, const SceneView* scene
 #endif
       break;
     }
-    c.v = light_vertex(scene, hit);
+    c.v = light_vertex(scene, hit.triangle, hit.b1, hit.b2);
     c.wo = v3_neg(dir);
     const float cos_g = v3_dot(c.v.point.normal, c.wo);
     if (cos_g == 0.0f) break;

@@ -1,12 +1,15 @@
 // What light paths share (light tracing, kernels/light_trace.cl; bidirectional path tracing,
 // kernels/bdpt.cl): contributions added as whole film quanta with integer atomics (splats),
 // the pinhole as a point sees it, the surfaces light paths reach and the adjoint weight of
-// their BSDF samples, and a light path's bounce with its roulette. One lane.
+// their BSDF samples, and a light path's bounce with its roulette. Written for FH_LANES
+// paths a work-item (lanes.h): a light path's rays and splats go lane by lane, the rest in
+// the lanes together.
 #ifndef FH_LIGHT_PATHS_H
 #define FH_LIGHT_PATHS_H
 
 #include "bsdf.h"
 #include "intersect.h"
+#include "lane_rays.h"
 #include "lights.h"
 #include "ray.h"
 #include "rng.h"
@@ -46,7 +49,7 @@ FH_INLINE float filter_density(__global const float* table, uint size, float rad
 // Adds the radiance c seen at image position p (pixels) to every pixel whose filter covers p,
 // weighted by its filter there. The box filter covers one pixel, the one p lies in.
 FH_INLINE void splat(RenderParams params, volatile __global uint* splats, __global const float* density, float2 p,
-                     lvec3 c) {
+                     float3 c) {
   const int w = params.camera.width, h = params.camera.height;
   const float r = params.filter_radius;
   const bool box = r <= 0.5f;  // weight one in the pixel p lies in, none elsewhere
@@ -72,9 +75,9 @@ FH_INLINE void splat(RenderParams params, volatile __global uint* splats, __glob
 // the image.
 typedef struct {
   lvec3 origin, to_camera;
-  float distance, importance;
-  float2 image;
-  int seen;
+  lfloat distance, importance;
+  lvec2 image;
+  lmask seen;
 } CameraView;
 
 FH_INLINE CameraView camera_view(RenderParams params, const SurfacePoint* at) {
@@ -87,14 +90,14 @@ FH_INLINE CameraView camera_view(RenderParams params, const SurfacePoint* at) {
   v.distance = v3_length(d);
   v.to_camera = v3_scale(d, 1.0f / v.distance);
   // Toward the point from the camera, on the image plane one unit ahead.
-  const float cos_theta = -v3_dot(v.to_camera, f);
+  const lfloat cos_theta = -v3_dot(v.to_camera, f);
   const lvec3 q = v3_scale(v.to_camera, -1.0f / cos_theta);
-  const float sx = v3_dot(q, right) / v3_dot(right, right), sy = v3_dot(q, up) / v3_dot(up, up);
-  v.image = (float2)(0.5f * (sx + 1.0f) * (float)cam->width, 0.5f * (1.0f - sy) * (float)cam->height);
+  const lfloat sx = v3_dot(q, right) / v3_dot(right, right), sy = v3_dot(q, up) / v3_dot(up, up);
+  v.image = lv2(0.5f * (sx + 1.0f) * (float)cam->width, 0.5f * (1.0f - sy) * (float)cam->height);
   const float reach = fmax(params.filter_radius - 0.5f, 0.0f);
   v.seen = cos_theta > 0.0f && v.distance > 0.0f && v.image.x >= -reach && v.image.x < (float)cam->width + reach &&
            v.image.y >= -reach && v.image.y < (float)cam->height + reach;
-  const float film_area = 4.0f * v3_length(right) * v3_length(up);
+  const lfloat film_area = 4.0f * v3_length(right) * v3_length(up);
   v.importance = 1.0f / (film_area * v.distance * v.distance * cos_theta * cos_theta * cos_theta);
   return v;
 }
@@ -105,20 +108,52 @@ typedef struct {
 } LightTally;
 
 // Splats `value` (the contribution before the camera's importance) where the camera sees
-// v from, if nothing lies between.
+// v from, in the lanes where `active` and nothing lies between.
 FH_INLINE void connect_to_camera(RenderParams params, const SceneView* scene, const CameraView* v, lvec3 value,
-                                 volatile __global uint* splats, __global const float* density, LightTally* tally) {
+                                 lmask active, volatile __global uint* splats, __global const float* density,
+                                 LightTally* tally) {
   const lvec3 c = v3_scale(value, v->importance);
-  if (!v3_any_positive(c)) return;
-  if (!(isfinite(c.x) && isfinite(c.y) && isfinite(c.z))) {
-    ++tally->nonfinite;
-    return;
+  lmask connects = active && v3_any_positive(c);
+  const lmask finite = isfinite(c.x) && isfinite(c.y) && isfinite(c.z);
+  tally->nonfinite += lanes_count(connects && !finite);
+  connects = connects && finite;
+  if (!lanes_any(connects)) return;
+  tally->camera_rays += lanes_count(connects);
+  LaneRays rays;
+  precompute_lane_rays(v->origin, v->to_camera, &rays);
+  for (uint left = lanes_bits(connects); left != 0u; left &= left - 1u) {
+    const int l = lowest_bit(left);
+    if (find_occluder_precomputed(scene->nodes, scene->blocks, lane_ray(&rays, l), 0.0f,
+                                  LANE(v->distance, l) * FH_SHADOW_SHORTEN) < 0)
+      splat(params, splats, density, (float2)(LANE(v->image.x, l), LANE(v->image.y, l)), v3_lane(c, l));
   }
-  ++tally->camera_rays;
-  const float3 org = (float3)(v->origin.x, v->origin.y, v->origin.z);
-  const float3 dir = (float3)(v->to_camera.x, v->to_camera.y, v->to_camera.z);
-  if (find_occluder(scene->nodes, scene->blocks, org, dir, 0.0f, v->distance * FH_SHADOW_SHORTEN) < 0)
-    splat(params, splats, density, v->image, c);
+}
+
+// The closest hit of each lane's ray where `active`, lane by lane (their constants set up
+// together: lane_rays.h); triangle -1 where there is none, or the lane is not active.
+typedef struct {
+  lint triangle;
+  lfloat t, b1, b2;
+} LaneHit;
+
+FH_INLINE LaneHit trace_lanes(const SceneView* scene, lvec3 org, lvec3 dir, lmask active) {
+  LaneRays rays;
+  precompute_lane_rays(org, dir, &rays);
+  LaneHit h;
+  h.triangle = (lint)(-1);
+  h.t = h.b1 = h.b2 = (lfloat)(0.0f);
+  const luint lanes = lane_positions(0);
+  for (uint left = lanes_bits(active); left != 0u; left &= left - 1u) {
+    const int l = lowest_bit(left);
+    const TraceHit one = trace_precomputed(scene->nodes, scene->blocks, lane_ray(&rays, l), 0.0f, INFINITY);
+    // Put together in registers (as intersect_lanes does): no lane stored and read back.
+    const lmask here = lanes == (luint)(l);
+    h.triangle = select(h.triangle, (lint)(one.triangle), here);
+    h.t = select(h.t, (lfloat)(one.t), here);
+    h.b1 = select(h.b1, (lfloat)(one.b1), here);
+    h.b2 = select(h.b2, (lfloat)(one.b2), here);
+  }
+  return h;
 }
 
 // The surface a light path reached: point, normals (the shading normal on the geometric
@@ -129,19 +164,20 @@ typedef struct {
   Bsdf bsdf;
 } LightVertex;
 
-FH_INLINE LightVertex light_vertex(const SceneView* scene, TraceHit hit) {
+// Triangle t (a valid index in every lane) at barycentrics (b1, b2).
+FH_INLINE LightVertex light_vertex(const SceneView* scene, lint t, lfloat b1, lfloat b2) {
   LightVertex v;
-  v.point = surface_point(scene->triangles, hit.triangle, hit.b1, hit.b2);
-  const MaterialLanes m = material_lanes(scene->materials, scene->triangle_material[hit.triangle]);
+  v.point = surface_point(scene->triangles, t, b1, b2);
+  const MaterialLanes m = material_lanes(scene->materials, gather_int(scene->triangle_material, las_uint(t)));
   v.bsdf = material_bsdf(&m);
 #if defined(FH_SHADING_NORMALS)
-  v.shading_normal = shading_normal(scene->normals, hit.triangle, hit.b1, hit.b2, v.point.normal);
+  v.shading_normal = shading_normal(scene->normals, t, b1, b2, v.point.normal);
 #else
   v.shading_normal = v.point.normal;
 #endif
 #if defined(FH_TEXTURES)
-  v.bsdf.kd = texture_lookup(scene->texels, scene->texture_info, m.texture,
-                             surface_uv(scene->uvs, hit.triangle, hit.b1, hit.b2), v.bsdf.kd);
+  v.bsdf.kd =
+      texture_lookup(scene->texels, scene->texture_info, m.texture, surface_uv(scene->uvs, t, b1, b2), v.bsdf.kd);
 #endif
   return v;
 }
@@ -153,45 +189,46 @@ FH_INLINE LightVertex light_vertex(const SceneView* scene, TraceHit hit) {
 // delta lobe's radiance weight is used without the 1/eta^2 of a refraction, which
 // radiance has and importance has not.
 FH_INLINE lvec3 adjoint_weight(const LightVertex* v, lvec3 n, lvec3 w_in, const BsdfSample* s) {
-  const float cos_g_in = fabs(v3_dot(v->point.normal, w_in)), cos_g_next = fabs(v3_dot(v->point.normal, s->wi));
-  const float correction = fabs(v3_dot(n, w_in)) * cos_g_next / cos_g_in;
-  if (s->pdf > 0.0f) return v3_scale(bsdf_eval(&v->bsdf, n, s->wi, w_in), correction / s->pdf);
+  const lfloat cos_g_in = fabs(v3_dot(v->point.normal, w_in)), cos_g_next = fabs(v3_dot(v->point.normal, s->wi));
+  const lfloat correction = fabs(v3_dot(n, w_in)) * cos_g_next / cos_g_in;
   lvec3 weight = v3_scale(s->weight, correction / fabs(v3_dot(n, s->wi)));
 #if defined(FH_GLASS)
-  const int refracted = v3_dot(v->point.normal, w_in) * v3_dot(v->point.normal, s->wi) < 0.0f;
-  if (has_lobe(&v->bsdf, FH_LOBE_GLASS) && refracted) {
-    const float eta = v3_dot(v->point.normal, w_in) >= 0.0f ? v->bsdf.eta : 1.0f / v->bsdf.eta;
-    weight = v3_scale(weight, eta * eta);
+  const lmask refracted = v3_dot(v->point.normal, w_in) * v3_dot(v->point.normal, s->wi) < 0.0f;
+  const lmask scaled = has_lobe(&v->bsdf, FH_LOBE_GLASS) && refracted;
+  if (lanes_any(scaled)) {
+    const lfloat eta = select(1.0f / v->bsdf.eta, v->bsdf.eta, v3_dot(v->point.normal, w_in) >= 0.0f);
+    weight = v3_select(scaled, v3_scale(weight, eta * eta), weight);
   }
 #endif
+  const lmask smooth = s->pdf > 0.0f;
+  if (lanes_any(smooth))
+    weight = v3_select(smooth, v3_scale(bsdf_eval(&v->bsdf, n, s->wi, w_in), correction / s->pdf), weight);
   return weight;
 }
 
-
-// A light path's next bounce from v: a BSDF sample with the light's side as wo, its adjoint
-// weight into alpha and into `carried` (the weights since the light, which roulette reads),
-// and Russian roulette from params.rr_depth scatterings on. Returns the sample; pdf 0: the
-// path ends there.
-FH_INLINE BsdfSample bounce_light_path(RenderParams params, const LightVertex* v, lvec3 n, lvec3 w_in,
-                                       uint scatterings, uint stream, uint path, uint* dim, lvec3* alpha,
+// A light path's next bounce from v, in the lanes where `active`: a BSDF sample with the
+// light's side as wo, its adjoint weight into alpha and into `carried` (the weights since
+// the light, which roulette reads), and Russian roulette from params.rr_depth scatterings
+// on. Returns the sample; pdf 0: the path ends there. The lanes draw the same dimensions
+// (*dim) at a bounce, so one count serves them all.
+FH_INLINE BsdfSample bounce_light_path(RenderParams params, const LightVertex* v, lvec3 n, lvec3 w_in, lmask active,
+                                       uint scatterings, luint stream, luint path, uint* dim, lvec3* alpha,
                                        lvec3* carried) {
-  const float u0 = random_float(stream, path, (*dim)++);
-  const float u1 = random_float(stream, path, (*dim)++), u2 = random_float(stream, path, (*dim)++);
+  const lfloat u0 = random_float(stream, path, (luint)((*dim)++));
+  const lfloat u1 = random_float(stream, path, (luint)((*dim)++)), u2 = random_float(stream, path, (luint)((*dim)++));
   BsdfSample s = bsdf_sample(&v->bsdf, v->point.normal, v->shading_normal, w_in, u0, u1, u2);
-  if (s.pdf == 0.0f) return s;
+  lmask goes = active && s.pdf != 0.0f;
   const lvec3 weight = adjoint_weight(v, n, w_in, &s);
-  *alpha = v3_mul(*alpha, weight);
-  *carried = v3_mul(*carried, weight);
+  *alpha = v3_select(goes, v3_mul(*alpha, weight), *alpha);
+  *carried = v3_select(goes, v3_mul(*carried, weight), *carried);
   if (scatterings >= params.rr_depth) {
-    const float survive = fmin(v3_max_component(*carried), 0.95f);
-    if (random_float(stream, path, (*dim)++) >= survive) {
-      s.pdf = 0.0f;
-      return s;
-    }
-    *alpha = v3_scale(*alpha, 1.0f / survive);
-    *carried = v3_scale(*carried, 1.0f / survive);
+    const lfloat survive = fmin(v3_max_component(*carried), 0.95f);
+    goes = goes && !(random_float(stream, path, (luint)((*dim)++)) >= survive);
+    *alpha = v3_select(goes, v3_scale(*alpha, 1.0f / survive), *alpha);
+    *carried = v3_select(goes, v3_scale(*carried, 1.0f / survive), *carried);
   }
-  if (!v3_any_positive(*alpha)) s.pdf = 0.0f;
+  goes = goes && v3_any_positive(*alpha);
+  s.pdf = select((lfloat)(0.0f), s.pdf, goes);
   return s;
 }
 

@@ -28,14 +28,17 @@ bool mergesLightVertices(Method method, bool deltaLobes) {
   return method == Method::VCM && (deltaLobes || testHooks().vcmMergeOnly);
 }
 
-ProgramSpec lightTracerProgram(Method method, const SceneFeatures& features, const std::string& traversalOptions) {
+ProgramSpec lightTracerProgram(Method method, const SceneFeatures& features, const std::string& traversalOptions,
+                               unsigned lanes) {
   const bool joined = bidirectional(method), vcm = method == Method::VCM;
   const int only = testHooks().bdptOnlyLightVertices;
   std::string strategy = joined && only >= 0 ? " -DFH_BDPT_ONLY_S=" + std::to_string(only) + "u" : "";
   if (vcm) strategy += testHooks().vcmMergeOnly ? " -DFH_VCM -DFH_VCM_MERGE_ONLY" : " -DFH_VCM";
+  const std::string lanesOption = " -DFH_LANES=" + std::to_string(lanes);
   return {std::string(joined ? "bidirectional path tracer (" : "light tracer (") + methodName(method) +
-              features.buildOptions() + strategy + ")",
-          {joined ? "bdpt.cl" : "light_trace.cl"}, traversalOptions + features.buildOptions() + strategy + " -DFH_LANES=1"};
+              features.buildOptions() + strategy + lanesOption + ")",
+          {joined ? "bdpt.cl" : "light_trace.cl"},
+          traversalOptions + features.buildOptions() + strategy + lanesOption};
 }
 
 LightTracer::LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bvh& bvh, const Camera& camera,
@@ -52,7 +55,9 @@ LightTracer::LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bv
       merges_(mergesLightVertices(s.method, scene.deltaLobes)),
       kernelName_(merges_                     ? "vcm_camera_subpaths"
                   : bidirectional(s.method) ? "bdpt"
-                                            : "light_trace") {
+                                            : "light_trace"),
+      // lt's light paths in the lanes a CPU's path tracer takes; bdpt's and vcm's one a work-item.
+      lanes_(bidirectional(s.method) ? 1 : lanesOf(strategyFor(dc.info, s.strategy))) {
   std::vector<float> inverseCdf;
   params_ = renderParams(s, camera, scene_, inverseCdf);
   // The splats weigh by the filter's density where camera rays are offset by its inverse CDF.
@@ -61,8 +66,9 @@ LightTracer::LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bv
                             density.data());
   // vcm without merging is bdpt, in bdpt's program.
   const Method programMethod = merges_ || !bidirectional(method_) ? method_ : Method::BDPT;
-  const cl::Program program = buildProgram(
-      dc.context, dc.info.device, lightTracerProgram(programMethod, scene_.features, scene_.bvh.traversalOptions()));
+  const cl::Program program =
+      buildProgram(dc.context, dc.info.device,
+                   lightTracerProgram(programMethod, scene_.features, scene_.bvh.traversalOptions(), lanes_));
   kernel_ = createKernel(program, kernelName_);
   if (bidirectional(method_)) {
     filterTable_ = allocateBuffer(dc.context, dc.info.device, CL_MEM_READ_ONLY, inverseCdf.size() * 4,
@@ -134,7 +140,7 @@ void LightTracer::enqueueIteration() {
   } else {
     bindAll(kernel_, kernelName_, params_, slot.global, slot.splats, density_, slot.tallies, scene_.buffers);
     cl::Event event;
-    launch(dc_, kernel_, pixels_, kernelName_, &event);
+    launch(dc_, kernel_, (pixels_ + lanes_ - 1) / lanes_, kernelName_, &event);
     events_.push_back({kernelName_, event});
   }
   FH_CL(dc_.queue.enqueueReadBuffer(slot.splats, CL_FALSE, 0, slot.splatWords.size() * 4, slot.splatWords.data()));

@@ -27,8 +27,10 @@
 namespace fh {
 
 // The light tracer's (method lt) or bidirectional path tracer's (bdpt) program for a scene's
-// features: one lane, one light path (and for bdpt one camera path) per work-item.
-ProgramSpec lightTracerProgram(Method method, const SceneFeatures& features, const std::string& traversalOptions);
+// features: `lanes` light paths per work-item for lt (kernels/lanes.h: 1, or 8 for a CPU),
+// one light path and one camera path per work-item for bdpt and vcm (lanes 1).
+ProgramSpec lightTracerProgram(Method method, const SceneFeatures& features, const std::string& traversalOptions,
+                               unsigned lanes);
 
 // Whether vcm merges light vertices in a scene with (or without) delta lobes
 // (render/device_scene.h hasDeltaLobes): only a delta lobe (glass, a mirror) can make
@@ -79,6 +81,7 @@ class LightTracer : public PassRenderer {
   Method method_;
   bool merges_;  // mergesLightVertices
   const char* kernelName_;
+  unsigned lanes_;  // light paths a work-item
   cl::Kernel kernel_;
   cl::Buffer density_;
   // bdpt: the filter's inverse CDF (camera paths) and the light vertices of one launch's paths.
