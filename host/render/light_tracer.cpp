@@ -56,8 +56,8 @@ LightTracer::LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bv
       kernelName_(merges_                     ? "vcm_camera_subpaths"
                   : bidirectional(s.method) ? "bdpt"
                                             : "light_trace"),
-      // lt's light paths in the lanes a CPU's path tracer takes; bdpt's and vcm's one a work-item.
-      lanes_(bidirectional(s.method) ? 1 : lanesOf(strategyFor(dc.info, s.strategy))) {
+      // The lanes the device's path tracer takes (eight on a CPU), but for vcm's merging.
+      lanes_(merges_ ? 1 : lanesOf(strategyFor(dc.info, s.strategy))) {
   std::vector<float> inverseCdf;
   params_ = renderParams(s, camera, scene_, inverseCdf);
   // The splats weigh by the filter's density where camera rays are offset by its inverse CDF.
@@ -134,7 +134,7 @@ void LightTracer::enqueueIteration() {
       bindAll(kernel_, kernelName_, params_, slot.global, first, count, sphere_, lightVertices_, filterTable_, slot.splats,
               density_, slot.tallies, scene_.buffers);
       cl::Event event;
-      launch(dc_, kernel_, count, kernelName_, &event);
+      launch(dc_, kernel_, (count + lanes_ - 1) / lanes_, kernelName_, &event);
       events_.push_back({kernelName_, event});
     }
   } else {

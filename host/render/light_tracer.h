@@ -27,8 +27,8 @@
 namespace fh {
 
 // The light tracer's (method lt) or bidirectional path tracer's (bdpt) program for a scene's
-// features: `lanes` light paths per work-item for lt (kernels/lanes.h: 1, or 8 for a CPU),
-// one light path and one camera path per work-item for bdpt and vcm (lanes 1).
+// features: `lanes` paths per work-item (kernels/lanes.h: 1, or 8 for a CPU), light paths
+// for lt, a light and a camera subpath each for bdpt; vcm's merging takes lanes 1.
 ProgramSpec lightTracerProgram(Method method, const SceneFeatures& features, const std::string& traversalOptions,
                                unsigned lanes);
 
