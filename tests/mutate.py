@@ -129,7 +129,7 @@ MUTATIONS = [Mutation(*m) for m in [
      "const luint slot = select(first_slot, own + FH_BDPT_VERTEX_WORDS * k, joining);",
      "const luint slot = own + FH_BDPT_VERTEX_WORDS * k;",
      "lanes past the launch's paths reading light vertices beyond the buffer",
-     r"^Runs/UnderOclgrind\.RunsWithoutReports/bdpt_lanes$"),
+     r"^Runs/UnderOclgrind\.RunsWithoutReports/bdpt_lanes "),
     ("lt-splat-carry-lost", "kernels/light_paths.h", "if (before + low < before) atomic_inc(sum + 1);",
      "if (before + low < before) atomic_inc(sum);", "a splat's carry out of the low word dropped",
      r"^Methods/LightTracing\.|^TwoDevices\.LightTracing"),
