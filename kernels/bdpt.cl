@@ -1,6 +1,9 @@
-// Bidirectional path tracing (--method bdpt; Veach 1997 ch. 10, Veach and Guibas 1995): each
-// work-item traces a light subpath from the emitters and a camera subpath through its pixel,
-// and joins them in every way a path of at most max_depth scattering vertices can be made:
+// Bidirectional path tracing (--method bdpt; Veach 1997 ch. 10, Veach and Guibas 1995): for
+// each pixel, a light subpath from the emitters and a camera subpath through the pixel,
+// joined in every way a path of at most max_depth scattering vertices can be made. A
+// work-item takes FH_LANES pixels (lanes.h: eight in vector lanes on a CPU), their light
+// subpaths bouncing together, then their camera subpaths, each lane joined to its own
+// light vertices; one lane or eight, the same bits:
 //   s = 0   the camera subpath hits an emitter,
 //   s = 1   a camera vertex connected to a point on an emitter (the light table, uniform in area)
 //           or, with FH_ENV_MAP, to a direction drawn from the environment map,
@@ -481,57 +484,97 @@ FH_INLINE uint merge_bucket(int i, int j, int k, uint mask) {
   return (((uint)i * 73856093u) ^ ((uint)j * 19349663u) ^ ((uint)k * 83492791u)) & mask;
 }
 
-// The weight a merge at camera vertex c counts with: the power heuristic's, or under
-// FH_VCM_MERGE_ONLY (a test hook) one at the first camera vertex and none elsewhere, so that
-// merging alone renders every path that scatters.
-FH_INLINE float merge_weight(float power_heuristic, const CameraVertex* c) {
+// The weight a merge at the camera's vertex number `scatterings` counts with: the power
+// heuristic's, or under FH_VCM_MERGE_ONLY (a test hook) one at the first camera vertex and
+// none elsewhere, so that merging alone renders every path that scatters.
+FH_INLINE lfloat merge_weight(lfloat power_heuristic, uint scatterings) {
 #if defined(FH_VCM_MERGE_ONLY)
-  return c->scatterings == 1u ? 1.0f : 0.0f;
+  return (lfloat)(scatterings == 1u ? 1.0f : 0.0f);
 #else
-  (void)c;
+  (void)scatterings;
   return power_heuristic;
 #endif
 }
 
-// Every light vertex within r of camera vertex c merged with it: the light's throughput
-// there times c's BSDF toward where that light came from, over the disk's area and N,
-// weighed against the connections that would make the same path (Georgiev's eqs. 38-39).
-// A merged path has one scattering vertex fewer than its two subpaths together.
-FH_INLINE lvec3 merge_light_vertices(const MergeGrid* grid, MergeFactors m, const CameraVertex* c, uint max_depth) {
-  const lvec3 x = c->v.point.position;
+// Lane l's BSDF in every lane: one camera vertex's, against light vertices in the lanes.
+FH_INLINE Bsdf bsdf_of_lane(const Bsdf* b, int l) {
+  Bsdf r;
+  r.kd = v3_uniform(v3_lane(b->kd, l));
+  r.ks = v3_uniform(v3_lane(b->ks, l));
+  r.tf = v3_uniform(v3_lane(b->tf, l));
+  r.alpha = (lfloat)(LANE(b->alpha, l));
+  r.eta = (lfloat)(LANE(b->eta, l));
+  r.p_specular = (lfloat)(LANE(b->p_specular, l));
+  r.lobes = (lint)(LANE(b->lobes, l));
+  return r;
+}
+
+// Every light vertex within r of lane l's camera vertex merged with it: the light's
+// throughput there times the camera vertex's BSDF toward where that light came from, over
+// the disk's area and N, weighed against the connections that would make the same path
+// (Georgiev's eqs. 38-39). A merged path has one scattering vertex fewer than its two
+// subpaths together. The candidates of a bucket are taken FH_LANES at a time, each in a lane,
+// and added in the bucket's order: the same sum as one at a time.
+FH_INLINE float3 merge_at_lane(const MergeGrid* grid, MergeFactors m, const CameraVertex* c, int l, uint max_depth) {
+  const float3 x = v3_lane(c->v.point.position, l);
+  const lvec3 g = v3_uniform(v3_lane(c->g, l)), n = v3_uniform(v3_lane(c->n, l)), wo = v3_uniform(v3_lane(c->wo, l));
+  const Bsdf bsdf = bsdf_of_lane(&c->v.bsdf, l);
+  const float d_vcm = LANE(c->d_vcm, l), d_vm = LANE(c->d_vm, l);
   const float r = grid->radius, r2 = r * r;
   const int i0 = merge_cell(x.x - r, grid->lo.x, grid->lo.w), i1 = merge_cell(x.x + r, grid->lo.x, grid->lo.w);
   const int j0 = merge_cell(x.y - r, grid->lo.y, grid->lo.w), j1 = merge_cell(x.y + r, grid->lo.y, grid->lo.w);
   const int k0 = merge_cell(x.z - r, grid->lo.z, grid->lo.w), k1 = merge_cell(x.z + r, grid->lo.z, grid->lo.w);
-  lvec3 sum = v3_splat(0.0f);
+  float3 sum = (float3)(0.0f);
   // Cells 2r wide: a disk of radius r meets at most two a side.
   for (int k = k0; k <= min(k1, k0 + 1); ++k)
     for (int j = j0; j <= min(j1, j0 + 1); ++j)
       for (int i = i0; i <= min(i1, i0 + 1); ++i) {
-        const uint bucket = merge_bucket(i, j, k, grid->mask);
-        for (uint e = grid->starts[bucket]; e < grid->starts[bucket + 1u]; ++e) {
-          const float4 p = grid->filed[e];
-          const lvec3 d = v3_sub(v3(p.x, p.y, p.z), x);
-          if (v3_dot(d, d) > r2) continue;
+        const uint bucket = merge_bucket(i, j, k, grid->mask), end = grid->starts[bucket + 1u];
+        for (uint first = grid->starts[bucket]; first < end; first += FH_LANES) {
+          const luint e = lane_positions(first);
+          lmask take = e < end;
+          lfloat slot_bits;
+          const lvec3 p = gather_xyzw(grid->filed, select((luint)(first), e, take), &slot_bits);
+          const lvec3 d = v3_sub(p, v3_uniform(x));
+          take = take && !(v3_dot(d, d) > r2);
           // Another cell's vertex in the same bucket is taken with its own cell (two of the
           // eight cells may share a bucket), as the host filed it.
-          if (merge_cell(p.x, grid->lo.x, grid->lo.w) != i || merge_cell(p.y, grid->lo.y, grid->lo.w) != j ||
-              merge_cell(p.z, grid->lo.z, grid->lo.w) != k)
-            continue;
-          __global const float4* s = grid->stored + FH_BDPT_VERTEX_WORDS * as_uint(p.w);
-          const float4 s0 = s[0], s1 = s[1], s2 = s[2], s3 = s[3];
-          if ((uint)s2.w + c->scatterings - 1u > max_depth) continue;
-          const lvec3 w_in = v3(s1.x, s1.y, s1.z);
-          const float cos_g = v3_dot(c->g, w_in);  // the light arrived on the camera's side
-          if (!(cos_g > 0.0f)) continue;
-          const lvec3 f = bsdf_eval(&c->v.bsdf, c->n, c->wo, w_in);
-          const float w_light = s0.w * m.vc + s3.w * mis2(bsdf_pdf(&c->v.bsdf, c->n, c->wo, w_in));
-          const float w_camera = c->d_vcm * m.vc + c->d_vm * mis2(bsdf_pdf(&c->v.bsdf, c->n, w_in, c->wo));
-          const float weight = merge_weight(1.0f / (w_light + 1.0f + w_camera), c);
-          sum = v3_add(sum, v3_scale(v3_mul(f, v3(s2.x, s2.y, s2.z)), fabs(v3_dot(c->n, w_in)) / cos_g * weight));
+          take = take && lconvert_int(floor((p.x - grid->lo.x) * grid->lo.w)) == i &&
+                 lconvert_int(floor((p.y - grid->lo.y) * grid->lo.w)) == j &&
+                 lconvert_int(floor((p.z - grid->lo.z) * grid->lo.w)) == k;
+          if (!lanes_any(take)) continue;
+          const luint slot = FH_BDPT_VERTEX_WORDS * select((luint)(0u), las_uint(slot_bits), take);
+          lfloat d_vcm_l, unused, scatterings_l, d_vm_l;
+          (void)gather_xyzw(grid->stored, slot, &d_vcm_l);
+          const lvec3 w_in = gather_xyzw(grid->stored, slot + 1u, &unused);
+          const lvec3 alpha = gather_xyzw(grid->stored, slot + 2u, &scatterings_l);
+          d_vm_l = gather_w(grid->stored, slot + 3u);
+          const lfloat cos_g = v3_dot(g, w_in);  // the light arrived on the camera's side
+          take = take && !(lconvert_uint(scatterings_l) + c->scatterings - 1u > max_depth) && cos_g > 0.0f;
+          if (!lanes_any(take)) continue;
+          const lvec3 f = bsdf_eval(&bsdf, n, wo, w_in);
+          const lfloat w_light = d_vcm_l * m.vc + d_vm_l * mis2(bsdf_pdf(&bsdf, n, wo, w_in));
+          const lfloat w_camera = d_vcm * m.vc + d_vm * mis2(bsdf_pdf(&bsdf, n, w_in, wo));
+          const lfloat weight = merge_weight(1.0f / (w_light + 1.0f + w_camera), c->scatterings);
+          const lvec3 each = v3_scale(v3_mul(f, alpha), fabs(v3_dot(n, w_in)) / cos_g * weight);
+          FH_FOR_LANES(q) {
+            if (LANE(take, q)) sum += (float3)(LANE(each.x, q), LANE(each.y, q), LANE(each.z, q));
+          }
         }
       }
-  return v3_scale(v3_mul(c->beta, sum), grid->scale);
+  return (v3_lane(c->beta, l) * sum) * grid->scale;
+}
+
+// Merging at the camera vertices of the lanes where `merging`, lane after lane.
+FH_INLINE lvec3 merge_light_vertices(const MergeGrid* grid, MergeFactors m, const CameraVertex* c, lmask merging,
+                                     uint max_depth) {
+  lvec3 merged = v3_splat(0.0f);
+  const luint lanes = lane_positions(0);
+  for (uint left = lanes_bits(merging); left != 0u; left &= left - 1u) {
+    const int l = lowest_bit(left);
+    merged = v3_select(lanes == (luint)(l), v3_uniform(merge_at_lane(grid, m, c, l, max_depth)), merged);
+  }
+  return merged;
 }
 #endif
 
@@ -644,7 +687,8 @@ FH_INLINE lvec3 trace_camera_subpath(RenderParams params, const SceneView* scene
         sum = v3_add(sum, connect_vertices(scene, m, &c, stored, slot, joining, tally));
       }
 #if defined(FH_VCM)
-      if (c.merge_here > 0.0f) sum = v3_add(sum, merge_light_vertices(grid, m, &c, params.max_depth));
+      const lmask merging = smooth && c.merge_here > 0.0f;
+      if (lanes_any(merging)) sum = v3_add(sum, merge_light_vertices(grid, m, &c, merging, params.max_depth));
 #endif
     }
 
@@ -716,28 +760,29 @@ __kernel void bdpt(RenderParams params, uint pass, uint first, uint count, float
   finish_path(path, sum, valid, splats, tallies, &tally);
 }
 #else
-#if FH_LANES != 1
-#error "vcm's merging takes one path a work-item"
-#endif
-// vcm, first: every light subpath of the launch, its vertices stored and counted.
+// vcm, first: every light subpath of the launch (FH_LANES a work-item), its vertices stored
+// and counted.
 __kernel void vcm_light_subpaths(RenderParams params, uint pass, uint first, uint count, float4 sphere, float2 factors,
                                  __global float4* stored, __global uint* stored_count, __global uint* splats,
                                  __global const float* density, __global uint* tallies FH_SCENE_PARAMS) {
-  const uint index = get_global_id(0);
-  if (index >= count) return;
-  const uint path = first + index;
-  stored_count[index] = 0u;
-  if (path >= params.pixel_count) return;
+  const luint index = lane_positions(get_global_id(0) * FH_LANES);
+  const luint path = first + index;
+  const lmask in_launch = index < count, valid = in_launch && path < params.pixel_count;
+  if (!lanes_any(in_launch)) return;
   const SceneView scene = FH_SCENE_VIEW;
-  const uint stream = hash_combine(params.seed, pass);
+  const luint stream = hash_combine((luint)(params.seed), (luint)(pass));
   const MergeFactors m = {factors.x, factors.y};
   LightTally tally = {0u, 0u, 0u};
-  stored_count[index] = trace_light_subpath(params, &scene, m, sphere, hash_combine(stream, 1u), path, 1, stored,
-                                            own_slots(index, params.max_depth), splats, density, &tally);
+  luint stored_here = (luint)(0u);
+  if (lanes_any(valid))
+    stored_here = trace_light_subpath(params, &scene, m, sphere, hash_combine(stream, (luint)(1u)), path, valid, stored,
+                                      own_slots(index, params.max_depth), splats, density, &tally);
+  scatter_uint(stored_count, index, select((luint)(0u), stored_here, valid), in_launch);
   atomic_add(tallies, tally.bounce_rays);
   atomic_add(tallies + 1, tally.camera_rays);
   if (tally.nonfinite) atomic_add(tallies + 2, tally.nonfinite);
 }
+
 // vcm, next: the stored vertices' positions, path after path (`offsets`: where each path's
 // go, from the host's running sum of the counts), for the host to file in the grid.
 __kernel void vcm_gather_positions(uint count, uint max_depth, __global const float4* stored,
@@ -749,17 +794,17 @@ __kernel void vcm_gather_positions(uint count, uint max_depth, __global const fl
     positions[offsets[index] + k] = stored[((size_t)index * max_depth + k) * FH_BDPT_VERTEX_WORDS + 3u];
 }
 
-// vcm, then: the camera subpaths, joined to their own light subpaths and merged with all of
-// the launch's.
+// vcm, then: the camera subpaths (FH_LANES a work-item), joined to their own light subpaths
+// and merged with all of the launch's.
 __kernel void vcm_camera_subpaths(RenderParams params, uint pass, uint first, uint count, float4 sphere, float2 factors,
                                   float4 grid_lo, float4 grid_merge, __global const float4* stored,
                                   __global const uint* stored_count, __global const uint* grid_starts,
                                   __global const float4* grid_filed, __global const float* filter_table,
                                   __global uint* splats, __global uint* tallies FH_SCENE_PARAMS) {
-  const uint index = get_global_id(0);
-  if (index >= count) return;
-  const uint path = first + index;
-  if (path >= params.pixel_count) return;
+  const luint index = lane_positions(get_global_id(0) * FH_LANES);
+  const luint path = first + index;
+  const lmask valid = index < count && path < params.pixel_count;
+  if (!lanes_any(valid)) return;
   const SceneView scene = FH_SCENE_VIEW;
   const MergeFactors m = {factors.x, factors.y};
   MergeGrid grid;
@@ -771,9 +816,11 @@ __kernel void vcm_camera_subpaths(RenderParams params, uint pass, uint first, ui
   grid.scale = grid_merge.y;
   grid.mask = as_uint(grid_merge.z);
   LightTally tally = {0u, 0u, 0u};
+  // Lanes past the launch read the first lane's count (lane 0 is always in it).
+  const luint light_vertices = gather_uint(stored_count, select((luint)(LANE(index, 0)), index, valid));
   const lvec3 sum =
-      trace_camera_subpath(params, &scene, m, sphere, pass, path, 1, stored, own_slots(index, params.max_depth),
-                           stored_count[index], filter_table, &tally, &grid);
-  finish_path(path, sum, 1, splats, tallies, &tally);
+      trace_camera_subpath(params, &scene, m, sphere, pass, path, valid, stored, own_slots(index, params.max_depth),
+                           light_vertices, filter_table, &tally, &grid);
+  finish_path(path, sum, valid, splats, tallies, &tally);
 }
 #endif

@@ -372,7 +372,8 @@ TEST(PathTracer, SpecializedAndAllFeatureKernelsAgree) {
 // The strategies run the same code with the same arithmetic, lane by lane: for a seed, one
 // path per work-item, eight in vector lanes and the megakernel render the same bits, on a
 // scene with every material feature (texture, glossy, mirror, glass, shading normals) and
-// for every method: light tracing's and bdpt's paths, too, one a work-item or eight in lanes.
+// for every method: light tracing's, bdpt's and vcm's paths, too, one a work-item or eight
+// in lanes (vcm merging, for the scene has glass).
 TEST(PathTracer, EveryStrategyRendersTheSameBits) {
   const Scene scene = loadScene(test::writeFeatureScene(test::tempDir("strategies")));
   DeviceContext& dc = test::defaultDevice();
@@ -380,7 +381,7 @@ TEST(PathTracer, EveryStrategyRendersTheSameBits) {
   Camera camera;
   camera.eye = {0.f, 1.f, 2.5f};
   camera.target = {0.f, 0.8f, 0.f};
-  for (Method method : {Method::PT, Method::NEE, Method::MIS, Method::LT, Method::BDPT}) {
+  for (Method method : {Method::PT, Method::NEE, Method::MIS, Method::LT, Method::BDPT, Method::VCM}) {
     RenderSettings s;
     s.width = s.height = 24;
     s.spp = 16;

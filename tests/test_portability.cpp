@@ -304,9 +304,9 @@ TEST_P(UnderOclgrind, RunsWithoutReports) {
     args = "render " + scenes.features + " --env-map " + writeEnvironmentMap(scenes.dir) +
            (run == "env" ? "" : " --method bdpt") + " --width 8 --height 8 --spp 1 --wavefront 64 -o " + scenes.dir +
            "/" + run + ".exr";
-  else if (run == "bdpt_lanes")  // eight paths a work-item, the last work-item's lanes past the image
-    args = "render " + scenes.features + " --method bdpt --strategy megakernel8 --width 7 --height 5 --spp 1 -o " +
-           scenes.dir + "/" + run + ".exr";
+  else if (run == "bdpt_lanes" || run == "vcm_lanes")  // eight paths a work-item, some lanes past the image
+    args = "render " + scenes.features + " --method " + run.substr(0, run.find('_')) +
+           " --strategy megakernel8 --width 7 --height 5 --spp 1 -o " + scenes.dir + "/" + run + ".exr";
   else
     args = "render " + scenes.features + " --method " + run + " --width 8 --height 8 --spp 1 --wavefront 64 -o " +
            scenes.dir + "/" + run + ".exr";
@@ -322,8 +322,8 @@ TEST_P(UnderOclgrind, RunsWithoutReports) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Runs, UnderOclgrind,
-                         ::testing::Values("pt", "nee", "mis", "lt", "bdpt", "bdpt_lanes", "vcm", "aov", "bench", "env",
-                                           "bdpt_env", "adaptive"),
+                         ::testing::Values("pt", "nee", "mis", "lt", "bdpt", "bdpt_lanes", "vcm", "vcm_lanes", "aov",
+                                           "bench", "env", "bdpt_env", "adaptive"),
                          [](const ::testing::TestParamInfo<const char*>& p) { return std::string(p.param); });
 
 }  // namespace

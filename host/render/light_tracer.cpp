@@ -56,8 +56,8 @@ LightTracer::LightTracer(DeviceContext& dc, const PreparedScene& scene, const Bv
       kernelName_(merges_                     ? "vcm_camera_subpaths"
                   : bidirectional(s.method) ? "bdpt"
                                             : "light_trace"),
-      // The lanes the device's path tracer takes (eight on a CPU), but for vcm's merging.
-      lanes_(merges_ ? 1 : lanesOf(strategyFor(dc.info, s.strategy))) {
+      // The lanes the device's path tracer takes (eight on a CPU).
+      lanes_(lanesOf(strategyFor(dc.info, s.strategy))) {
   std::vector<float> inverseCdf;
   params_ = renderParams(s, camera, scene_, inverseCdf);
   // The splats weigh by the filter's density where camera rays are offset by its inverse CDF.
@@ -161,7 +161,7 @@ void LightTracer::mergeLaunch(Slot& slot, unsigned first) {
   bindAll(lightKernel_, "vcm_light_subpaths", params_, slot.global, first, count, sphere_, factors, lightVertices_,
           storedCounts_, slot.splats, density_, slot.tallies, scene_.buffers);
   cl::Event lightEvent;
-  launch(dc_, lightKernel_, count, "vcm_light_subpaths", &lightEvent);
+  launch(dc_, lightKernel_, (count + lanes_ - 1) / lanes_, "vcm_light_subpaths", &lightEvent);
   events_.push_back({"vcm_light_subpaths", lightEvent});
   // Only the stored vertices' positions come back: gathered by the running sum of the counts.
   counts_.resize(count);
@@ -191,7 +191,7 @@ void LightTracer::mergeLaunch(Slot& slot, unsigned first) {
   bindAll(kernel_, kernelName_, params_, slot.global, first, count, sphere_, factors, gridLo, merge, lightVertices_,
           storedCounts_, gridStarts_, gridFiled_, filterTable_, slot.splats, slot.tallies, scene_.buffers);
   cl::Event event;
-  launch(dc_, kernel_, count, kernelName_, &event);
+  launch(dc_, kernel_, (count + lanes_ - 1) / lanes_, kernelName_, &event);
   events_.push_back({kernelName_, event});
 }
 

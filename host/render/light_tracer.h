@@ -28,7 +28,7 @@ namespace fh {
 
 // The light tracer's (method lt) or bidirectional path tracer's (bdpt) program for a scene's
 // features: `lanes` paths per work-item (kernels/lanes.h: 1, or 8 for a CPU), light paths
-// for lt, a light and a camera subpath each for bdpt; vcm's merging takes lanes 1.
+// for lt, a light and a camera subpath each for bdpt and vcm.
 ProgramSpec lightTracerProgram(Method method, const SceneFeatures& features, const std::string& traversalOptions,
                                unsigned lanes);
 
