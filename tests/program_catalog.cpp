@@ -67,17 +67,20 @@ std::vector<ProgramSpec> programVariants(FeatureSpan span) {
   for (Method method : {Method::LT, Method::BDPT, Method::VCM})
     for (const SceneFeatures& features : materialSets)
       programs.push_back(lightTracerProgram(method, features, traversal, 1));
-  // Their paths in eight lanes (a CPU's).
-  for (Method method : {Method::LT, Method::BDPT, Method::VCM})
-    for (const SceneFeatures& features : materialSets)
-      programs.push_back(lightTracerProgram(method, features, traversal, 8));
   // bdpt's and vcm's light subpaths from the environment map too.
   for (Method method : {Method::BDPT, Method::VCM})
     programs.push_back(lightTracerProgram(method, SceneFeatures::all(), traversal, 1));
-  for (Method method : {Method::BDPT, Method::VCM})
-    programs.push_back(lightTracerProgram(method, SceneFeatures::all(), traversal, 8));
   for (Strategy strategy : {Strategy::Scalar, Strategy::Simd8, Strategy::Megakernel8})
     programs.push_back(pathTracerProgram(SceneFeatures::all(), Method::LT, traversal, strategy));
+  return programs;
+}
+
+std::vector<ProgramSpec> cpuLaneVariants() {
+  const std::string traversal = "-DFH_TRAVERSAL_STACK=64";
+  std::vector<ProgramSpec> programs;
+  for (Method method : {Method::LT, Method::BDPT, Method::VCM})
+    for (const SceneFeatures& features : {SceneFeatures{}, SceneFeatures::all()})
+      programs.push_back(lightTracerProgram(method, features, traversal, 8));
   return programs;
 }
 

@@ -18,6 +18,11 @@ enum class FeatureSpan { EveryCombination, NoneAndAll };
 
 std::vector<ProgramSpec> programVariants(FeatureSpan span);
 
+// What only a CPU builds beyond programVariants: the light methods' kernels in eight lanes
+// (their lanes: GPUs take one), with none and with all features. The portable front end
+// compiles them (spir64); a GPU back end never sees them.
+std::vector<ProgramSpec> cpuLaneVariants();
+
 // The feature macros SceneFeatures::buildOptions() defines.
 std::vector<std::string> featureMacros();
 

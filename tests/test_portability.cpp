@@ -34,15 +34,16 @@ struct Target {
   const char* flags;  // target triple and what it needs
   const char* output; // what to emit: every target runs its backend where one exists
   FeatureSpan span;   // the material feature sets compiled
+  bool cpuLanes;      // also what only a CPU builds (cpuLaneVariants)
 };
 
 // SPIR's front end checks every variant a scene can ask for. The two back ends, which take
 // most of the time, compile every kernel with none and with all of the features: both sides
 // of every feature switch (FeatureSwitches.NoConditionNamesTwoFeatures below).
 const Target kTargets[] = {
-    {"spir64", "-target spir64", "-emit-llvm -c", FeatureSpan::EveryCombination},
-    {"nvptx64", "-target nvptx64-nvidia-nvcl", "-S", FeatureSpan::NoneAndAll},
-    {"amdgcn", "-target amdgcn-amd-amdhsa -mcpu=gfx900 -nogpulib", "-S", FeatureSpan::NoneAndAll},
+    {"spir64", "-target spir64", "-emit-llvm -c", FeatureSpan::EveryCombination, true},
+    {"nvptx64", "-target nvptx64-nvidia-nvcl", "-S", FeatureSpan::NoneAndAll, false},
+    {"amdgcn", "-target amdgcn-amd-amdhsa -mcpu=gfx900 -nogpulib", "-S", FeatureSpan::NoneAndAll, false},
 };
 
 // OpenCL C 1.2 as a device compiler sees it: the standard header, no optional extension
@@ -61,9 +62,11 @@ struct Compiled {
 };
 
 // Compiles the program variants of `span` with `flags` on all cores; returns each result.
-std::vector<Compiled> compileVariants(FeatureSpan span, const std::string& tag, const std::string& flags,
-                                      const std::string& output) {
-  const std::vector<ProgramSpec> programs = programVariants(span);
+std::vector<Compiled> compileVariants(FeatureSpan span, bool cpuLanes, const std::string& tag,
+                                      const std::string& flags, const std::string& output) {
+  std::vector<ProgramSpec> programs = programVariants(span);
+  if (cpuLanes)
+    for (ProgramSpec& p : cpuLaneVariants()) programs.push_back(std::move(p));
   const std::string dir = test::tempDir(tag);
   std::vector<Compiled> results(programs.size());
   std::atomic<size_t> next{0};
@@ -88,7 +91,7 @@ class OfflineCompile : public ::testing::TestWithParam<Target> {};
 TEST_P(OfflineCompile, EveryProgramVariantWithoutErrorsOrWarnings) {
   ASSERT_TRUE(fs::exists(FREDHOLM_CLANG)) << "clang not found (" << FREDHOLM_CLANG << "): apt-get install clang";
   const Target& target = GetParam();
-  const auto results = compileVariants(target.span, target.name,
+  const auto results = compileVariants(target.span, target.cpuLanes, target.name,
                                        std::string(kStrict) + " " + kWarnings + " -O2 " + target.flags, target.output);
   // intersect, bench rays, aov, 3 methods x 2 strategies x the feature sets
   EXPECT_GE(results.size(), target.span == FeatureSpan::EveryCombination ? 99u : 15u);
@@ -200,7 +203,7 @@ TEST(FeatureSwitches, BackEndsBuildEachProgramWithNoneAndAll) {
 // so an unmangled declaration is one of fredholm's helpers left undefined.
 TEST(OfflineCompileWithoutInlining, NoHelperIsLeftUndefined) {
   ASSERT_TRUE(fs::exists(FREDHOLM_CLANG)) << "clang not found (" << FREDHOLM_CLANG << "): apt-get install clang";
-  const auto results = compileVariants(FeatureSpan::EveryCombination, "noinline",
+  const auto results = compileVariants(FeatureSpan::EveryCombination, true, "noinline",
                                        std::string(kStrict) + " -O0 -DFH_NO_FORCED_INLINE -target spir64",
                                        "-emit-llvm -S");
   const std::regex declaration(R"(^declare [^@]*@([A-Za-z_][A-Za-z0-9_.]*)\()");
