@@ -313,22 +313,6 @@ typedef struct {
   uint scatterings;   // this vertex's count from the camera, 1 for the first hit (the lanes' alike)
 } CameraVertex;
 
-// Of the lanes where `active`, those whose ray from org along dir is clear up to t_max (each
-// lane's ray in turn).
-FH_INLINE lmask clear_lanes(const SceneView* scene, lvec3 org, lvec3 dir, lfloat t_max, lmask active,
-                            LightTally* tally) {
-  tally->camera_rays += lanes_count(active);
-  LaneRays rays;
-  precompute_lane_rays(org, dir, &rays);
-  uint clear = 0u;
-  for (uint left = lanes_bits(active); left != 0u; left &= left - 1u) {
-    const int l = lowest_bit(left);
-    if (find_occluder_precomputed(scene->nodes, scene->blocks, lane_ray(&rays, l), 0.0f, LANE(t_max, l)) < 0)
-      clear |= 1u << l;
-  }
-  return lanes_of_bits(clear);
-}
-
 // Of the lanes where `active`, those whose segment from a to b (both points just off their
 // surfaces) is clear.
 FH_INLINE lmask unoccluded(const SceneView* scene, lvec3 a, lvec3 b, lmask active, LightTally* tally) {
@@ -729,14 +713,30 @@ FH_INLINE void finish_path(luint path, lvec3 sum, lmask valid, __global uint* sp
     }
   }
   tally->nonfinite += lanes_count(valid && !finite);
-  atomic_add(tallies, tally->bounce_rays);
-  atomic_add(tallies + 1, tally->camera_rays);
-  if (tally->nonfinite) atomic_add(tallies + 2, tally->nonfinite);
+  add_tally(tallies, tally);
 }
 
 // Where each lane's light vertices go in `stored` (a float4 index): max_depth slots a path,
 // by its place in the launch.
 FH_INLINE luint own_slots(luint index, uint max_depth) { return index * (max_depth * FH_BDPT_VERTEX_WORDS); }
+
+// A work-item's paths, one a lane: their places in the launch of `count` paths from the
+// pass's path `first` (`index`: what the vertex buffer's slots follow) and their numbers in
+// the pass (`path`); `in_launch` where the place is in the launch, `valid` where the path
+// is also one of the pass's pixels.
+typedef struct {
+  luint index, path;
+  lmask in_launch, valid;
+} LaunchLanes;
+
+FH_INLINE LaunchLanes launch_lanes(RenderParams params, uint first, uint count) {
+  LaunchLanes w;
+  w.index = lane_positions(get_global_id(0) * FH_LANES);
+  w.path = first + w.index;
+  w.in_launch = w.index < count;
+  w.valid = w.in_launch && w.path < params.pixel_count;
+  return w;
+}
 
 #if !defined(FH_VCM)
 // bdpt: a work-item's light subpaths (FH_LANES of them: lanes.h), then its camera subpaths
@@ -744,20 +744,18 @@ FH_INLINE luint own_slots(luint index, uint max_depth) { return index * (max_dep
 __kernel void bdpt(RenderParams params, uint pass, uint first, uint count, float4 sphere, __global float4* stored,
                    __global const float* filter_table, __global uint* splats, __global const float* density,
                    __global uint* tallies FH_SCENE_PARAMS) {
-  const luint index = lane_positions(get_global_id(0) * FH_LANES);
-  const luint path = first + index;
-  const lmask valid = index < count && path < params.pixel_count;
-  if (!lanes_any(valid)) return;
+  const LaunchLanes w = launch_lanes(params, first, count);
+  if (!lanes_any(w.valid)) return;
   const SceneView scene = FH_SCENE_VIEW;
   const luint stream = hash_combine((luint)(params.seed), (luint)(pass));
   const MergeFactors none = {0.0f, 0.0f};
   LightTally tally = {0u, 0u, 0u};
-  const luint own = own_slots(index, params.max_depth);
+  const luint own = own_slots(w.index, params.max_depth);
   const luint light_vertices = trace_light_subpath(params, &scene, none, sphere, hash_combine(stream, (luint)(1u)),
-                                                   path, valid, stored, own, splats, density, &tally);
-  const lvec3 sum = trace_camera_subpath(params, &scene, none, sphere, pass, path, valid, stored, own, light_vertices,
-                                         filter_table, &tally);
-  finish_path(path, sum, valid, splats, tallies, &tally);
+                                                   w.path, w.valid, stored, own, splats, density, &tally);
+  const lvec3 sum = trace_camera_subpath(params, &scene, none, sphere, pass, w.path, w.valid, stored, own,
+                                         light_vertices, filter_table, &tally);
+  finish_path(w.path, sum, w.valid, splats, tallies, &tally);
 }
 #else
 // vcm, first: every light subpath of the launch (FH_LANES a work-item), its vertices stored
@@ -765,22 +763,18 @@ __kernel void bdpt(RenderParams params, uint pass, uint first, uint count, float
 __kernel void vcm_light_subpaths(RenderParams params, uint pass, uint first, uint count, float4 sphere, float2 factors,
                                  __global float4* stored, __global uint* stored_count, __global uint* splats,
                                  __global const float* density, __global uint* tallies FH_SCENE_PARAMS) {
-  const luint index = lane_positions(get_global_id(0) * FH_LANES);
-  const luint path = first + index;
-  const lmask in_launch = index < count, valid = in_launch && path < params.pixel_count;
-  if (!lanes_any(in_launch)) return;
+  const LaunchLanes w = launch_lanes(params, first, count);
+  if (!lanes_any(w.in_launch)) return;
   const SceneView scene = FH_SCENE_VIEW;
   const luint stream = hash_combine((luint)(params.seed), (luint)(pass));
   const MergeFactors m = {factors.x, factors.y};
   LightTally tally = {0u, 0u, 0u};
   luint stored_here = (luint)(0u);
-  if (lanes_any(valid))
-    stored_here = trace_light_subpath(params, &scene, m, sphere, hash_combine(stream, (luint)(1u)), path, valid, stored,
-                                      own_slots(index, params.max_depth), splats, density, &tally);
-  scatter_uint(stored_count, index, select((luint)(0u), stored_here, valid), in_launch);
-  atomic_add(tallies, tally.bounce_rays);
-  atomic_add(tallies + 1, tally.camera_rays);
-  if (tally.nonfinite) atomic_add(tallies + 2, tally.nonfinite);
+  if (lanes_any(w.valid))
+    stored_here = trace_light_subpath(params, &scene, m, sphere, hash_combine(stream, (luint)(1u)), w.path, w.valid,
+                                      stored, own_slots(w.index, params.max_depth), splats, density, &tally);
+  scatter_uint(stored_count, w.index, select((luint)(0u), stored_here, w.valid), w.in_launch);
+  add_tally(tallies, &tally);
 }
 
 // vcm, next: the stored vertices' positions, path after path (`offsets`: where each path's
@@ -801,10 +795,8 @@ __kernel void vcm_camera_subpaths(RenderParams params, uint pass, uint first, ui
                                   __global const uint* stored_count, __global const uint* grid_starts,
                                   __global const float4* grid_filed, __global const float* filter_table,
                                   __global uint* splats, __global uint* tallies FH_SCENE_PARAMS) {
-  const luint index = lane_positions(get_global_id(0) * FH_LANES);
-  const luint path = first + index;
-  const lmask valid = index < count && path < params.pixel_count;
-  if (!lanes_any(valid)) return;
+  const LaunchLanes w = launch_lanes(params, first, count);
+  if (!lanes_any(w.valid)) return;
   const SceneView scene = FH_SCENE_VIEW;
   const MergeFactors m = {factors.x, factors.y};
   MergeGrid grid;
@@ -817,10 +809,10 @@ __kernel void vcm_camera_subpaths(RenderParams params, uint pass, uint first, ui
   grid.mask = as_uint(grid_merge.z);
   LightTally tally = {0u, 0u, 0u};
   // Lanes past the launch read the first lane's count (lane 0 is always in it).
-  const luint light_vertices = gather_uint(stored_count, select((luint)(LANE(index, 0)), index, valid));
+  const luint light_vertices = gather_uint(stored_count, select((luint)(LANE(w.index, 0)), w.index, w.valid));
   const lvec3 sum =
-      trace_camera_subpath(params, &scene, m, sphere, pass, path, valid, stored, own_slots(index, params.max_depth),
-                           light_vertices, filter_table, &tally, &grid);
-  finish_path(path, sum, valid, splats, tallies, &tally);
+      trace_camera_subpath(params, &scene, m, sphere, pass, w.path, w.valid, stored,
+                           own_slots(w.index, params.max_depth), light_vertices, filter_table, &tally, &grid);
+  finish_path(w.path, sum, w.valid, splats, tallies, &tally);
 }
 #endif

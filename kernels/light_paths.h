@@ -107,6 +107,29 @@ typedef struct {
   uint bounce_rays, camera_rays, nonfinite;
 } LightTally;
 
+// Adds a work-item's tally to the launch's (bounce rays, camera rays, non-finite values).
+FH_INLINE void add_tally(__global uint* tallies, const LightTally* tally) {
+  atomic_add(tallies, tally->bounce_rays);
+  atomic_add(tallies + 1, tally->camera_rays);
+  if (tally->nonfinite) atomic_add(tallies + 2, tally->nonfinite);
+}
+
+// Of the lanes where `active`, those whose ray from org along dir is clear up to t_max (each
+// lane's ray in turn); each ray counts as a camera ray.
+FH_INLINE lmask clear_lanes(const SceneView* scene, lvec3 org, lvec3 dir, lfloat t_max, lmask active,
+                            LightTally* tally) {
+  tally->camera_rays += lanes_count(active);
+  LaneRays rays;
+  precompute_lane_rays(org, dir, &rays);
+  uint clear = 0u;
+  for (uint left = lanes_bits(active); left != 0u; left &= left - 1u) {
+    const int l = lowest_bit(left);
+    if (find_occluder_precomputed(scene->nodes, scene->blocks, lane_ray(&rays, l), 0.0f, LANE(t_max, l)) < 0)
+      clear |= 1u << l;
+  }
+  return lanes_of_bits(clear);
+}
+
 // Splats `value` (the contribution before the camera's importance) where the camera sees
 // v from, in the lanes where `active` and nothing lies between.
 FH_INLINE void connect_to_camera(RenderParams params, const SceneView* scene, const CameraView* v, lvec3 value,
@@ -118,14 +141,10 @@ FH_INLINE void connect_to_camera(RenderParams params, const SceneView* scene, co
   tally->nonfinite += lanes_count(connects && !finite);
   connects = connects && finite;
   if (!lanes_any(connects)) return;
-  tally->camera_rays += lanes_count(connects);
-  LaneRays rays;
-  precompute_lane_rays(v->origin, v->to_camera, &rays);
-  for (uint left = lanes_bits(connects); left != 0u; left &= left - 1u) {
+  const lmask seen = clear_lanes(scene, v->origin, v->to_camera, v->distance * FH_SHADOW_SHORTEN, connects, tally);
+  for (uint left = lanes_bits(seen); left != 0u; left &= left - 1u) {
     const int l = lowest_bit(left);
-    if (find_occluder_precomputed(scene->nodes, scene->blocks, lane_ray(&rays, l), 0.0f,
-                                  LANE(v->distance, l) * FH_SHADOW_SHORTEN) < 0)
-      splat(params, splats, density, (float2)(LANE(v->image.x, l), LANE(v->image.y, l)), v3_lane(c, l));
+    splat(params, splats, density, (float2)(LANE(v->image.x, l), LANE(v->image.y, l)), v3_lane(c, l));
   }
 }
 

@@ -94,7 +94,5 @@ __kernel void light_trace(RenderParams params, uint pass, __global uint* splats,
     dir = s.wi;
     org = offset_ray_origin(&v.point, s.wi);
   }
-  atomic_add(tallies, tally.bounce_rays);
-  atomic_add(tallies + 1, tally.camera_rays);
-  if (tally.nonfinite) atomic_add(tallies + 2, tally.nonfinite);
+  add_tally(tallies, &tally);
 }
