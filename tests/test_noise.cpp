@@ -58,6 +58,25 @@ TEST(NoiseTarget, EstimateMatchesTheTruthOnTheVeachPlates) {
   expectEstimateNearTheTruth(loadScene(test::testScene("veach/veach-plates.obj")), 96, 64, 16384, {3e-2, 1e-2});
 }
 
+// The typical estimate (the median of five interleaved sets' means) is the mean estimate
+// where the noise is even and where it is all in one region, which each set samples alike;
+// one pixel's firefly, which decides the mean, moves it by little.
+TEST(NoiseEstimate, TheTypicalEstimateIsTheMeanButForAFewPixels) {
+  const auto none = [](int, int) { return false; };
+  // Each set's mean has a relative deviation of about 2 % (4 % in the region's case).
+  const Film even = test::noisyFilm(100, 16, 0.1, 0.1, none, 1);
+  EXPECT_NEAR(even.typicalRelMse(), even.estimatedRelMse(), 0.1 * even.estimatedRelMse());
+  // A quarter of the image ten times as noisy: a hundred times the error there.
+  const Film region = test::noisyFilm(100, 16, 0.1, 1.0, [](int x, int y) { return x < 50 && y < 50; }, 2);
+  EXPECT_GT(region.estimatedRelMse(), 20 * even.estimatedRelMse());
+  EXPECT_NEAR(region.typicalRelMse(), region.estimatedRelMse(), 0.15 * region.estimatedRelMse());
+  // A firefly in each of two pixels, (1, 1) and (50, 50), of sets 3 and 0: a sample of 1000.
+  Film fireflies = even;
+  fireflies.addPass(test::passWithFireflies(fireflies, {101, 5050}, 1000.f));
+  EXPECT_GT(fireflies.estimatedRelMse(), 100 * even.estimatedRelMse());
+  EXPECT_LT(fireflies.typicalRelMse(), 1.5 * even.typicalRelMse());
+}
+
 // Stopping is decided on merged passes only, so the image for a seed and target is the
 // same whatever the wavefront size (which changes how many passes are in flight).
 TEST(NoiseTarget, TheStopIsDeterministic) {

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <cmath>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -295,6 +296,30 @@ std::vector<float> exrChannels(const std::string& path, std::vector<std::string>
   in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, values.data());
   if (names) *names = spec.channelnames;
   return values;
+}
+
+Film noisyFilm(int side, int passes, double sigma, double regionSigma, const std::function<bool(int, int)>& inRegion,
+               unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal;
+  Film film(side, side, false, true);
+  for (int pass = 0; pass < passes; ++pass) {
+    std::vector<float> samples;
+    for (int p = 0; p < side * side; ++p) {
+      const double deviation = inRegion(p % side, p / side) ? regionSigma : sigma;
+      for (int c = 0; c < 3; ++c) samples.push_back(float(0.5 + deviation * normal(rng)));
+      samples.push_back(1.f);
+    }
+    film.addPass(samples);
+  }
+  return film;
+}
+
+std::vector<float> passWithFireflies(const Film& film, const std::vector<size_t>& pixels, float value) {
+  std::vector<float> pass;
+  for (size_t p = 0; p < film.pixels(); ++p) pass.insert(pass.end(), {0.5f, 0.5f, 0.5f, 1.f});
+  for (size_t p : pixels) pass[4 * p] = pass[4 * p + 1] = pass[4 * p + 2] = value;
+  return pass;
 }
 
 }  // namespace fh::test

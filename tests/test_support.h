@@ -3,11 +3,13 @@
 // running the CLI, brute-force ray oracles.
 #pragma once
 #include <cmath>
+#include <functional>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "device/device_context.h"
+#include "render/film.h"
 #include "render/render.h"
 #include "render/settings.h"
 #include "scene/camera.h"
@@ -57,6 +59,14 @@ CommandResult runCommand(const std::string& command);
 nlohmann::json readJson(const std::string& path);
 // Runs the fredholm binary with `args` (a shell-quoted string) and optional environment prefix.
 CommandResult runFredholm(const std::string& args, const std::string& env = "");
+
+// A film of `side`² pixels of value 0.5 in `passes` passes of two replicates, each sample
+// with Gaussian noise of deviation `sigma`, or `regionSigma` at the pixels (x, y) where
+// `inRegion` is true.
+Film noisyFilm(int side, int passes, double sigma, double regionSigma, const std::function<bool(int, int)>& inRegion,
+               unsigned seed);
+// A pass of that film's size with every sample 0.5 but at `pixels`, `value` there.
+std::vector<float> passWithFireflies(const Film& film, const std::vector<size_t>& pixels, float value);
 
 // Writes a small scene into `dir` that reaches every material feature the kernels have:
 // a textured floor (map_Kd, UVs), glossy and mirror walls, a glass prism, a wall with

@@ -396,7 +396,7 @@ nlohmann::json choiceJson(const MethodChoice& c) {
   nlohmann::json methods = nlohmann::json::object();
   for (const MethodTrial& t : c.trials)
     methods[methodName(t.method)] = {
-        {"seconds", t.seconds},          {"relmse", t.relMse},     {"cost", t.cost()},
+        {"seconds", t.seconds},          {"relmse", t.relMse},     {"mean_relmse", t.meanRelMse}, {"cost", t.cost()},
         {"cross_relmse", t.crossRelMse}, {"cross_cost", t.crossCost()}, {"passes", t.passes}};
   nlohmann::json candidates = nlohmann::json::array();
   for (Method m : c.candidates) candidates.push_back(methodName(m));

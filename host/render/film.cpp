@@ -149,13 +149,15 @@ class NeighbourMeans {
 
 }  // namespace
 
-double Film::estimatedRelMse() const {
+// Calls add(pixel, e) with each pixel's share of the estimated relMSE: its channels' expected
+// squared errors over the converged value squared plus relMSE's epsilon, summed.
+template <typename Add>
+void Film::forEachPixelRelMse(Add add) const {
   // relMSE divides by the converged value; the pixel's own mean stands in for it badly: a
   // rare bright sample raises both the pixel's error and its mean, so the two cancel and the
   // estimate runs low where such samples dominate. The neighbours' means do not depend on
   // the pixel's samples (bench/RESULTS.md, "--noise").
   NeighbourMeans neighbours(*this);
-  double total = 0.0;
   const double* converged = nullptr;  // the row's, 3 per pixel
   for (size_t p = 0; p < pixels(); ++p) {
     if (p % size_t(width) == 0) converged = neighbours.row(p / size_t(width));
@@ -167,6 +169,7 @@ double Film::estimatedRelMse() const {
     const double nOdd = oddSum.empty() ? 0.0 : oddSum[kOddSumsPerPixel * p + 3], nEven = n - nOdd;
     const bool replicated = nOdd > 0 && nEven > 0;
     const std::array<double, 3> variance = varianceOfMean(p);
+    double share = 0.0;
     for (size_t c = 0; c < 3; ++c) {
       double error = variance[c];
       if (replicated) {
@@ -174,10 +177,33 @@ double Film::estimatedRelMse() const {
         error = d * d * nEven * nOdd / (n * n);
       }
       const double value = converged[3 * (p % size_t(width)) + c];
-      total += error / (value * value + kRelMseEpsilon);
+      share += error / (value * value + kRelMseEpsilon);
     }
+    add(p, share);
   }
+}
+
+double Film::estimatedRelMse() const {
+  double total = 0.0;
+  forEachPixelRelMse([&](size_t, double share) { total += share; });
   return pixels() ? total / double(3 * pixels()) : 0.0;
+}
+
+double Film::typicalRelMse() const {
+  // Pixel (x, y) is in set (x + 2y) mod 5: any five pixels in a row or a column fall in
+  // five different sets, so each set samples every region of the image alike.
+  constexpr size_t kSets = 5;
+  const auto setOf = [&](size_t p) { return (p % size_t(width) + 2 * (p / size_t(width))) % kSets; };
+  std::array<double, kSets> total{}, pixelsIn{};
+  forEachPixelRelMse([&](size_t p, double share) { total[setOf(p)] += share; });
+  for (size_t p = 0; p < pixels(); ++p) pixelsIn[setOf(p)] += 1.0;
+  std::vector<double> means;
+  for (size_t k = 0; k < kSets; ++k)
+    if (pixelsIn[k] > 0) means.push_back(total[k] / (3.0 * pixelsIn[k]));
+  if (means.empty()) return 0.0;
+  std::sort(means.begin(), means.end());
+  const size_t mid = means.size() / 2;
+  return means.size() % 2 ? means[mid] : (means[mid - 1] + means[mid]) / 2;
 }
 
 double Film::samples() const {

@@ -73,6 +73,12 @@ struct Film {
   // passes' means (unbiased, as the two are independent); else the sample variance / count,
   // which overstates the error of low-discrepancy samples (they are not independent).
   double estimatedRelMse() const;
+  // The same estimate, robust to a few pixels: the median of its means over five interleaved
+  // sets of pixels (a median of means). In a short render a method's rare bright samples
+  // land in a few pixels, whose error then decides the mean, and which sets they fall in
+  // decides little of the median; an error spread over many pixels moves each set's mean
+  // alike. Where no pixel stands out it is about estimatedRelMse.
+  double typicalRelMse() const;
   uint64_t passes() const { return passes_; }
   // The first pass held; for an empty film, the first it was made to hold.
   uint64_t firstPass() const { return held_.empty() ? firstPass_ : held_.front().first; }
@@ -110,6 +116,8 @@ struct Film {
 
  private:
   std::vector<float> aovMean(size_t first) const;
+  template <typename Add>
+  void forEachPixelRelMse(Add add) const;
   uint64_t firstPass_ = 0, passes_ = 0;
   PassRanges held_;
 };

@@ -178,7 +178,8 @@ MethodChoice chooseMethod(const std::vector<DeviceInfo>& devices, const Scene& s
       choice.pilotHeight = p.height;
       const RenderResult r = render(devices, scene, bvh, camera, p, links);
       if (r.stopped || !r.complete) break;
-      choice.trials.push_back({method, steadySeconds(r.stats), r.film.estimatedRelMse(), unsigned(r.film.passes())});
+      choice.trials.push_back({method, steadySeconds(r.stats), r.film.typicalRelMse(), unsigned(r.film.passes()), 0.0,
+                               r.film.estimatedRelMse()});
       images.push_back(r.film.image());
     }
     if (choice.trials.size() == methods.size()) judgePilots(choice.trials, images);

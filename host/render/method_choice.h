@@ -44,9 +44,12 @@ constexpr double kMostPilotShare = 0.2;
 struct MethodTrial {
   Method method = Method::MIS;
   double seconds = 0.0;  // the pilot's render time (set-up and compiling excluded)
-  double relMse = 0.0;   // the pilot image's relMSE, estimated from its own two replicates
+  // The pilot image's relMSE, estimated from its own two replicates: the typical estimate
+  // (Film::typicalRelMse), which one firefly in a short pilot does not decide.
+  double relMse = 0.0;
   unsigned passes = 0;   // the pilot's passes (samples per pixel)
   double crossRelMse = 0.0;  // the same as the other pilots see it (judgePilots; 0: not judged)
+  double meanRelMse = 0.0;   // the own estimate's plain mean (Film::estimatedRelMse), for --stats
   double cost() const { return relMse * seconds; }
   double crossCost() const { return crossRelMse * seconds; }
 };
@@ -87,7 +90,10 @@ std::vector<Method> methodsFor(const Scene& scene, const RenderSettings& s);
 // kChoiceMargin, and where the trials were judged by each other (crossRelMse), beats mis's
 // cost by the margin in that judgement too; else mis. The two estimates fail apart: a pilot's
 // own misses what neither of its halves found, and on a pilot image whose lights are a pixel
-// wide it runs high for every method alike, where the others' still ranks them.
+// wide it runs high for every method alike, where the others' still ranks them. The own
+// estimate is the typical one: its plain mean, in a pilot of a few dozen samples a pixel,
+// was decided by one firefly often enough to keep a method at a third of mis's error from
+// being chosen (bench/history/method_choice.md).
 Method cheapestMethod(const std::vector<MethodTrial>& trials);
 
 // Each pilot's relMSE as the other pilots see it. The pilots are independent unbiased
