@@ -495,6 +495,22 @@ TEST_F(Mtl, ReflectanceAboveOneScaledDownWithAWarning) {
   EXPECT_TRUE(onlyNoLights(scene));
 }
 
+// The MTL glass models (illum 4, 6, 7, 9) have a diffuse Kd and a specular Ks too; fredholm's
+// glass reflects by Fresnel's law alone and tints what it transmits by Tf, so a Kd or Ks
+// above zero there is said to be unused, at its line. Zero is what the glass renders.
+TEST_F(Mtl, GlassSaysItsKdAndKsAreUnused) {
+  Scene scene = load("newmtl g\nillum 7\nNi 1.5\nKd 0.8 0 0\nKs 0.3 0.3 0.3\nTf 0.9\n", "g");
+  EXPECT_EQ(warningsWith(scene, "scene.mtl:4: material 'g': Kd 0.8 0 0 and Ks 0.3 0.3 0.3 not used by glass (illum 7)")
+                .size(),
+            1u);
+  scene = load("newmtl g\nKs 0.5\nillum 4\nNi 1.5\nKd 0 0 0\nTf 0.9\n", "g");
+  EXPECT_EQ(warningsWith(scene, "scene.mtl:2: material 'g': Ks 0.5 0.5 0.5 not used by glass (illum 4)").size(), 1u);
+  scene = load("newmtl g\nillum 4\nNi 1.5\nKd 0 0 0\nTf 0.9\n", "g");
+  EXPECT_TRUE(warningsWith(scene, "not used by glass").empty());
+  // The same Kd on a diffuse model is used: nothing said.
+  EXPECT_TRUE(warningsWith(load("newmtl a\nillum 2\nKd 0.8 0 0\n"), "not used").empty());
+}
+
 // What the renderer ignores is said once per kind of statement, naming the first line.
 TEST_F(Mtl, IgnoredStatementsWarnedOncePerKind) {
   const Scene scene = load(

@@ -488,10 +488,28 @@ void conserve(PendingMaterial& m, PendingMaterial::Colour& c, const char* what, 
                      " " + what + " more light than it receives; scaled down to " + rgb(c.value));
 }
 
+// A glass model's reflectance is Fresnel's, from Ni, and its transmission is tinted by Tf
+// (kernels/bsdf.h): a Kd or Ks above zero, which the MTL models would use, is not. Said once
+// a material, at the first such statement's line.
+void warnUnusedByGlass(const PendingMaterial& m, const std::string& file, std::vector<std::string>& warnings) {
+  std::string unused;
+  int line = 0;
+  for (const PendingMaterial::Colour* c : {&m.kd, &m.ks})
+    if (c->at != SIZE_MAX && std::max({c->value[0], c->value[1], c->value[2]}) > 0.f) {
+      unused += (unused.empty() ? "" : " and ") + c->key + " " + rgb(c->value);
+      line = line ? std::min(line, c->line) : c->line;
+    }
+  if (!unused.empty())
+    warnings.push_back(file + ":" + std::to_string(line) + ": material '" + m.name + "': " + unused +
+                       " not used by glass (illum " + std::to_string(m.illum) +
+                       "): it reflects by Fresnel's law from Ni, and Tf tints what it transmits");
+}
+
 void flush(PendingMaterial& m, const std::string& file, std::string& out, std::vector<std::string>& warnings) {
   if (m.keep) {
     if (isGlassModel(m.illum)) {
       conserve(m, m.tf, "transmits", file, warnings);
+      warnUnusedByGlass(m, file, warnings);
     } else {
       // The BSDF (kernels/bsdf.h) conserves energy when Kd and Ks are each at most one: the
       // diffuse lobe gets only what the specular lobe's Fresnel leaves over.
