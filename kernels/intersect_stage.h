@@ -22,21 +22,10 @@ FH_INLINE void intersect_lanes(__global const Bvh8Node* nodes, __global const Tr
                                FH_PATH_SPACE FH_PATH_TYPE(float4)* hit) {
   lfloat t_min, t_max;
   const lvec3 org = gather_xyzw(ray_org, p, &t_min), dir = gather_xyzw(ray_dir, p, &t_max);
-  LaneRays rays;
-  precompute_lane_rays(org, dir, &rays);
-  // Each active lane's ray on its own; the hits are put together in registers and stored
-  // once (a lane written in memory and read back as a vector waits for the store).
-  lvec3 found = v3_splat(0.0f);
-  lfloat triangle = (lfloat)(0.0f);
-  const luint lanes = lane_positions(0);
-  for (uint left = lanes_bits(active); left != 0u; left &= left - 1u) {
-    const int l = lowest_bit(left);
-    const float4 h = stored_hit(trace_precomputed(nodes, blocks, lane_ray(&rays, l), LANE(t_min, l), LANE(t_max, l)));
-    const lmask here = lanes == (luint)(l);
-    found = v3_select(here, v3_uniform(h.xyz), found);
-    triangle = select(triangle, (lfloat)(h.w), here);
-  }
-  scatter_xyzw(hit, p, found, triangle, active);
+  const LaneHit h = closest_hits(nodes, blocks, org, dir, t_min, t_max, active);
+  // As stored_hit stores each.
+  const lfloat t = select(h.t, (lfloat)(INFINITY), h.triangle < 0);
+  scatter_xyzw(hit, p, v3(t, h.b1, h.b2), las_float(h.triangle), active);
 }
 
 // intersect_lanes for the camera rays of samples that start together (the megakernel's

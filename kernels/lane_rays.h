@@ -33,4 +33,34 @@ FH_INLINE void precompute_lane_rays(lvec3 org, lvec3 dir, LaneRays* rays) {
 FH_INLINE RayPrecomp lane_ray(const LaneRays* rays, int l) { return *rays; }
 #endif
 
+// The closest hit of each lane's ray where `active`, within [t_min, t_max], lane by lane
+// (their constants set up together); triangle -1 where there is none, or the lane is not
+// active.
+typedef struct {
+  lint triangle;
+  lfloat t, b1, b2;
+} LaneHit;
+
+FH_INLINE LaneHit closest_hits(__global const Bvh8Node* nodes, __global const TriangleBlock8* blocks, lvec3 org,
+                               lvec3 dir, lfloat t_min, lfloat t_max, lmask active) {
+  LaneRays rays;
+  precompute_lane_rays(org, dir, &rays);
+  LaneHit h;
+  h.triangle = (lint)(-1);
+  h.t = h.b1 = h.b2 = (lfloat)(0.0f);
+  const luint lanes = lane_positions(0);
+  for (uint left = lanes_bits(active); left != 0u; left &= left - 1u) {
+    const int l = lowest_bit(left);
+    const TraceHit one = trace_precomputed(nodes, blocks, lane_ray(&rays, l), LANE(t_min, l), LANE(t_max, l));
+    // Put together in registers: a lane written in memory and read back as a vector waits
+    // for the store.
+    const lmask here = lanes == (luint)(l);
+    h.triangle = select(h.triangle, (lint)(one.triangle), here);
+    h.t = select(h.t, (lfloat)(one.t), here);
+    h.b1 = select(h.b1, (lfloat)(one.b1), here);
+    h.b2 = select(h.b2, (lfloat)(one.b2), here);
+  }
+  return h;
+}
+
 #endif

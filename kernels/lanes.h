@@ -37,6 +37,7 @@ typedef int lmask;
 #define lconvert_int(x) convert_int(x)
 #define las_int(x) as_int(x)
 #define las_uint(x) as_uint(x)
+#define las_float(x) as_float(x)
 #elif FH_LANES == 8
 typedef float8 lfloat;
 typedef int8 lint;
@@ -49,6 +50,7 @@ typedef int8 lmask;
 #define lconvert_int(x) convert_int8(x)
 #define las_int(x) as_int8(x)
 #define las_uint(x) as_uint8(x)
+#define las_float(x) as_float8(x)
 #else
 #error "FH_LANES must be 1 or 8"
 #endif

@@ -148,31 +148,9 @@ FH_INLINE void connect_to_camera(RenderParams params, const SceneView* scene, co
   }
 }
 
-// The closest hit of each lane's ray where `active`, lane by lane (their constants set up
-// together: lane_rays.h); triangle -1 where there is none, or the lane is not active.
-typedef struct {
-  lint triangle;
-  lfloat t, b1, b2;
-} LaneHit;
-
+// The closest hit of each lane's ray where `active` (closest_hits over the whole ray).
 FH_INLINE LaneHit trace_lanes(const SceneView* scene, lvec3 org, lvec3 dir, lmask active) {
-  LaneRays rays;
-  precompute_lane_rays(org, dir, &rays);
-  LaneHit h;
-  h.triangle = (lint)(-1);
-  h.t = h.b1 = h.b2 = (lfloat)(0.0f);
-  const luint lanes = lane_positions(0);
-  for (uint left = lanes_bits(active); left != 0u; left &= left - 1u) {
-    const int l = lowest_bit(left);
-    const TraceHit one = trace_precomputed(scene->nodes, scene->blocks, lane_ray(&rays, l), 0.0f, INFINITY);
-    // Put together in registers (as intersect_lanes does): no lane stored and read back.
-    const lmask here = lanes == (luint)(l);
-    h.triangle = select(h.triangle, (lint)(one.triangle), here);
-    h.t = select(h.t, (lfloat)(one.t), here);
-    h.b1 = select(h.b1, (lfloat)(one.b1), here);
-    h.b2 = select(h.b2, (lfloat)(one.b2), here);
-  }
-  return h;
+  return closest_hits(scene->nodes, scene->blocks, org, dir, (lfloat)(0.0f), (lfloat)(INFINITY), active);
 }
 
 // The surface a light path reached: point, normals (the shading normal on the geometric
