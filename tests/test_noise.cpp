@@ -7,6 +7,8 @@
 #include <OpenImageIO/imageio.h>
 
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "image/error_metrics.h"
@@ -113,6 +115,31 @@ TEST(NoiseCli, MeetsTheTargetAndWritesTheEstimate) {
     EXPECT_NE(e.output.find("--noise"), std::string::npos) << e.output;
     EXPECT_FALSE(std::filesystem::exists(dir + "/bad.exr"));
   }
+}
+
+// A scene lit a thousand times more dimly meets the same --noise after fewer passes: its
+// pixels' squares are far below relMSE's epsilon, so the estimate measures absolute error.
+// The render says so, and the default scene's does not.
+TEST(NoiseCli, ADimImageMeetingTheTargetSaysSo) {
+  const std::string dir = test::tempDir("noise-dim");
+  const std::string obj = test::projectScene("cornell-box/CornellBox-Original.obj");
+  std::ifstream mtl(obj.substr(0, obj.size() - 4) + ".mtl");
+  std::stringstream text;
+  text << mtl.rdbuf();
+  std::string dim = text.str();
+  const size_t at = dim.find("Ke 17 12 4");
+  ASSERT_NE(at, std::string::npos);
+  dim.replace(at, 10, "Ke 0.017 0.012 0.004");
+  test::writeFile(dir + "/CornellBox-Original.mtl", dim);
+  std::filesystem::copy_file(obj, dir + "/dim.obj");
+  const std::string flags = " --width 24 --height 24 --noise 3e-3 --spp 4096 --force -o ";
+  const auto bright = test::runFredholm("render" + flags + dir + "/bright.exr");
+  ASSERT_EQ(bright.exitCode, 0) << bright.output;
+  EXPECT_EQ(bright.output.find("is dim"), std::string::npos) << bright.output;
+  const auto dimmed = test::runFredholm("render " + dir + "/dim.obj" + flags + dir + "/dim.exr");
+  ASSERT_EQ(dimmed.exitCode, 0) << dimmed.output;
+  EXPECT_NE(dimmed.output.find("fredholm: warning: the image is dim (mean "), std::string::npos) << dimmed.output;
+  EXPECT_NE(dimmed.output.find("measured absolute error (met after 16 passes)"), std::string::npos) << dimmed.output;
 }
 
 }  // namespace

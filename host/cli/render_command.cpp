@@ -1,5 +1,6 @@
 // `fredholm render`: flags checked before any work, then scene, camera, BVH, one render on
 // every device --device selects, and the image with its metadata.
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -23,6 +24,7 @@
 #include "device/devices.h"
 #include "display/live_view.h"
 #include "image/denoiser.h"
+#include "image/error_metrics.h"
 #include "image/image_io.h"
 #include "render/checkpoint.h"
 #include "render/method_choice.h"
@@ -460,6 +462,25 @@ std::map<std::string, std::string> imageMetadata(const RenderOptions& o, const S
   return metadata;
 }
 
+// relMSE divides each pixel's squared error by its value squared plus kRelMseEpsilon, the
+// literature's for images whose pixels are about one. Where the image's mean is below a tenth
+// of the epsilon's square root, a typical pixel's square is a hundredth of the epsilon: the
+// estimate then measures absolute error, and --noise is met after few passes however noisy
+// the image looks once exposed. Said, not changed: relMSE stays the measure `compare` and
+// the benchmarks use.
+constexpr double kDimImageMean = 0.01;
+
+void warnIfDim(const Film& film, double target) {
+  const Image image = film.image();
+  double mean = 0.0;
+  for (float v : image.rgb) mean += double(v) / double(std::max<size_t>(image.rgb.size(), 1));
+  if (mean >= kDimImageMean || mean <= 0.0) return;
+  std::cerr << "fredholm: warning: the image is dim (mean " << formatScientific(mean) << "): relMSE's epsilon of "
+            << kRelMseEpsilon << " outweighs its pixels' squares, so --noise " << formatScientific(target)
+            << " measured absolute error (met after " << film.passes()
+            << " passes); brighter emitters (Ke) or a smaller --noise give the noise an exposed image shows\n";
+}
+
 void printSummary(const RenderOptions& o, const RenderSettings& settings, const Scene& scene, const RenderResult& r,
                   const std::string& method, double spp, double seconds, double noise) {
   std::cerr << "fredholm: rendered " << scene.sourcePath << " (" << scene.triangleCount() << " triangles, "
@@ -472,6 +493,7 @@ void printSummary(const RenderOptions& o, const RenderSettings& settings, const 
     const bool met = noise <= settings.noise;
     std::cerr << "fredholm: estimated relMSE " << formatScientific(noise) << (met ? " meets" : " has not reached")
               << " --noise " << formatScientific(settings.noise) << (met ? "" : " (stopped by --spp or --time)") << "\n";
+    if (met) warnIfDim(r.film, settings.noise);
   }
 }
 
