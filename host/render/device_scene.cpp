@@ -172,11 +172,7 @@ void mendReflectance(float rgb[3], TextureData& t) {
     for (int c = 0; c < 3; ++c) rgb[c] = std::max(rgb[c], 0.f);
     ++t.negative;
   }
-  const float most = std::max({rgb[0], rgb[1], rgb[2]});
-  if (most > 1.f) {
-    for (int c = 0; c < 3; ++c) rgb[c] = std::min(rgb[c] / most, 1.f);
-    ++t.aboveOne;
-  }
+  if (capReflectance(rgb)) ++t.aboveOne;
 }
 
 // What loadTexture mended, for a warning; empty if nothing.

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "base/error.h"
+#include "scene/scene.h"
 
 namespace fh {
 namespace {
@@ -473,16 +474,12 @@ struct PendingMaterial {
   } kd, ks, tf;
 };
 
-bool isGlassModel(int illum) { return illum == 4 || illum == 6 || illum == 7 || illum == 9; }
-
 // Scales a reflectance the renderer uses down to a largest channel of one (hue kept).
 void conserve(PendingMaterial& m, PendingMaterial::Colour& c, const char* what, const std::string& file,
               std::vector<std::string>& warnings) {
   if (c.at == SIZE_MAX) return;
-  const float largest = std::max({c.value[0], c.value[1], c.value[2]});
-  if (!(largest > 1.f)) return;
   const float before[3] = {c.value[0], c.value[1], c.value[2]};
-  for (float& v : c.value) v /= largest;
+  if (!capReflectance(c.value)) return;
   m.lines[c.at] = c.key + " " + rgb(c.value);
   warnings.push_back(file + ":" + std::to_string(c.line) + ": material '" + m.name + "': " + c.key + " " + rgb(before) +
                      " " + what + " more light than it receives; scaled down to " + rgb(c.value));
@@ -507,7 +504,7 @@ void warnUnusedByGlass(const PendingMaterial& m, const std::string& file, std::v
 
 void flush(PendingMaterial& m, const std::string& file, std::string& out, std::vector<std::string>& warnings) {
   if (m.keep) {
-    if (isGlassModel(m.illum)) {
+    if (isGlassIllum(m.illum)) {
       conserve(m, m.tf, "transmits", file, warnings);
       warnUnusedByGlass(m, file, warnings);
     } else {

@@ -1,6 +1,7 @@
 // A scene as flat, device-ready arrays: what the loader produces and the BVH, the
 // kernels and the tests consume.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -11,6 +12,9 @@
 namespace fh {
 
 using Vec3f = std::array<float, 3>;
+
+// The MTL illum models fredholm renders as a smooth dielectric (kernels/bsdf.h).
+inline bool isGlassIllum(int illum) { return illum == 4 || illum == 6 || illum == 7 || illum == 9; }
 
 // The MTL fields later stages use. Tf only means transmission for the glass illum
 // models (4, 6, 7, 9): `isGlass()` says when.
@@ -27,8 +31,17 @@ struct Material {
   int kdTexture = -1;  // index into Scene::textures, -1 for none
 
   bool isEmissive() const { return ke[0] > 0.f || ke[1] > 0.f || ke[2] > 0.f; }
-  bool isGlass() const { return illum == 4 || illum == 6 || illum == 7 || illum == 9; }
+  bool isGlass() const { return isGlassIllum(illum); }
 };
+
+// Scales a reflectance whose largest channel is above one (it would reflect more light than
+// it receives) down to a largest channel of one, its hue kept; returns whether it did.
+inline bool capReflectance(float rgb[3]) {
+  const float most = std::max({rgb[0], rgb[1], rgb[2]});
+  if (!(most > 1.f)) return false;
+  for (int c = 0; c < 3; ++c) rgb[c] /= most;
+  return true;
+}
 
 struct Texture {
   std::string path;  // resolved on disk (case-insensitive fallback applied)
