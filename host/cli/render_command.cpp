@@ -470,19 +470,19 @@ std::map<std::string, std::string> imageMetadata(const RenderOptions& o, const S
 // the benchmarks use.
 constexpr double kDimImageMean = 0.01;
 
-void warnIfDim(const Film& film, double target) {
-  const Image image = film.image();
-  double mean = 0.0;
-  for (float v : image.rgb) mean += double(v) / double(std::max<size_t>(image.rgb.size(), 1));
+void warnIfDim(const Image& image, uint64_t passes, double target) {
+  double total = 0.0;
+  for (float v : image.rgb) total += double(v);
+  const double mean = image.rgb.empty() ? 0.0 : total / double(image.rgb.size());
   if (mean >= kDimImageMean || mean <= 0.0) return;
   std::cerr << "fredholm: warning: the image is dim (mean " << formatScientific(mean) << "): relMSE's epsilon of "
             << kRelMseEpsilon << " outweighs its pixels' squares, so --noise " << formatScientific(target)
-            << " measured absolute error (met after " << film.passes()
+            << " measured absolute error (met after " << passes
             << " passes); brighter emitters (Ke) or a smaller --noise give the noise an exposed image shows\n";
 }
 
 void printSummary(const RenderOptions& o, const RenderSettings& settings, const Scene& scene, const RenderResult& r,
-                  const std::string& method, double spp, double seconds, double noise) {
+                  const Image& image, const std::string& method, double spp, double seconds, double noise) {
   std::cerr << "fredholm: rendered " << scene.sourcePath << " (" << scene.triangleCount() << " triangles, "
             << scene.lights.size() << " emissive; "
             << (o.allFeatures ? "all features" : featuresFor(scene, settings).describe())
@@ -493,7 +493,7 @@ void printSummary(const RenderOptions& o, const RenderSettings& settings, const 
     const bool met = noise <= settings.noise;
     std::cerr << "fredholm: estimated relMSE " << formatScientific(noise) << (met ? " meets" : " has not reached")
               << " --noise " << formatScientific(settings.noise) << (met ? "" : " (stopped by --spp or --time)") << "\n";
-    if (met) warnIfDim(r.film, settings.noise);
+    if (met) warnIfDim(image, r.film.passes(), settings.noise);
   }
 }
 
@@ -588,7 +588,7 @@ int runRender(RenderOptions o) {
                 deliver(metadata));
   }
   const std::string written = deliver(metadata);
-  printSummary(o, settings, scene, r, method, spp, seconds, estimatedRelMse);
+  printSummary(o, settings, scene, r, image, method, spp, seconds, estimatedRelMse);
   plan.finish();
   std::cout << "wrote " << written << "\n";
   return 0;
