@@ -434,6 +434,32 @@ TEST(RenderCli, EmittersOfAnyBrightnessRenderTheSameImageScaled) {
   }
 }
 
+// Every surface of the Cornell box emitting Ke: at 1e37 its pixels are bright but within
+// float, at 3e38 they sum past it, which no image file can hold: an error, and no file.
+TEST(RenderCli, PixelsPastTheFloatRangeAreAnErrorAndNoFile) {
+  const std::string dir = test::tempDir("float-range");
+  const std::string obj = test::projectScene("cornell-box/CornellBox-Original.obj");
+  std::ifstream in(obj.substr(0, obj.size() - 4) + ".mtl");
+  std::string mtl;
+  for (std::string line; std::getline(in, line);)
+    mtl += (line.find("Ke ") != std::string::npos ? std::string("Ke KE KE KE") : line) + "\n";
+  std::filesystem::copy_file(obj, dir + "/box.obj");
+  auto render = [&](const std::string& ke) {
+    std::string text = mtl;
+    for (size_t at = text.find("KE"); at != std::string::npos; at = text.find("KE", at)) text.replace(at, 2, ke);
+    test::writeFile(dir + "/CornellBox-Original.mtl", text);
+    return test::runFredholm("render " + dir + "/box.obj --width 16 --height 16 --spp 4 -o " + dir + "/" + ke + ".exr");
+  };
+  const auto within = render("1e37");
+  EXPECT_EQ(within.exitCode, 0) << within.output;
+  EXPECT_TRUE(std::filesystem::exists(dir + "/1e37.exr"));
+  const auto past = render("3e38");
+  EXPECT_NE(past.exitCode, 0) << past.output;
+  EXPECT_NE(past.output.find("fredholm: error: "), std::string::npos) << past.output;
+  EXPECT_NE(past.output.find("past the float range"), std::string::npos) << past.output;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/3e38.exr"));
+}
+
 TEST(CompareCli, MetricsMeansAndBlocks) {
   const std::string dir = test::tempDir("cli");
   Image a, b;

@@ -481,6 +481,19 @@ void warnIfDim(const Image& image, uint64_t passes, double target) {
             << " passes); brighter emitters (Ke) or a smaller --noise give the noise an exposed image shows\n";
 }
 
+// Radiance past the float range has no value to write: a pixel summed to infinity would
+// pass for a bright one in a PNG and for the scene's answer in an EXR. No file is written.
+void refuseNonFiniteImage(const Image& image) {
+  size_t bad = 0, first = 0;
+  for (size_t i = 0; i < image.rgb.size(); ++i)
+    if (!std::isfinite(image.rgb[i]) && bad++ == 0) first = i / 3;
+  if (bad == 0) return;
+  throw Error(std::to_string(bad) + " pixel values of the image are past the float range (first at pixel (" +
+              std::to_string(first % size_t(image.width)) + ", " + std::to_string(first / size_t(image.width)) +
+              ")): the emitters (Ke, --env, --env-map times --env-scale) are too bright for 32-bit floats; "
+              "nothing written");
+}
+
 void printSummary(const RenderOptions& o, const RenderSettings& settings, const Scene& scene, const RenderResult& r,
                   const Image& image, const std::string& method, double spp, double seconds, double noise) {
   std::cerr << "fredholm: rendered " << scene.sourcePath << " (" << scene.triangleCount() << " triangles, "
@@ -567,6 +580,7 @@ int runRender(RenderOptions o) {
   if (settings.adaptive) metadata["adaptive"] = "1";
   if (choice) metadata["method_choice"] = choiceMetadata(*choice);
   const Image image = r.film.imageWithLayers(layers);
+  refuseNonFiniteImage(image);
   const std::string passes = std::to_string(r.film.passes()) + " passes";
   // The files, and the live view's last frame: the image as written.
   const auto deliver = [&](const std::map<std::string, std::string>& facts) {
