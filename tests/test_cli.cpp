@@ -26,6 +26,7 @@ TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
       {"--method foo", "--method 'foo': unknown method (use pt, nee, mis, lt, bdpt, vcm or auto)"},
       {"--filter tent", "--filter 'tent': unknown filter"},
       {"--env 1,1,x", "--env '1,1,x': 'x' is not a number"},
+      {"--env 1e39,1,1", "--env '1e39,1,1': '1e39' is beyond the float range"},
       {"--aov shiny", "--aov 'shiny': unknown output"},
       {"--eye 0,1", "--eye '0,1': expected three comma-separated numbers"},
       {"--width 0", "--width/--height must be positive"},
@@ -42,7 +43,8 @@ TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
       {"--wavefront 0", "--wavefront must be at least 64"},
       {"--spp 1 --spp 2", "fredholm: error: --spp"},
       // The strategy and roulette flags.
-      {"--strategy vector", "--strategy 'vector': unknown strategy (use auto, scalar, simd8, megakernel or megakernel8)"},
+      {"--strategy vector",
+       "--strategy 'vector': unknown strategy (use auto, scalar, simd8, megakernel or megakernel8)"},
       {"--rr-depth 0", "--rr-depth must be at least 1"},
       // vcm's merging radius: a fraction of the scene's, and vcm's alone.
       {"--method vcm --merge-radius 0", "--merge-radius must be a fraction of the scene's radius, from 1e-4 to 1"},
@@ -53,9 +55,11 @@ TEST(RenderCli, BadFlagsAreOneLineErrorsBeforeAnyWork) {
       {"--method vcm --adaptive", "--method vcm does not go with --adaptive"},
       {"--method vcm --aovs albedo", "--method vcm records no first surfaces, which --aovs 'albedo' asks for"},
       // What light tracing cannot do yet, named before any work.
-      {"--method lt --env 1,1,1", "--method lt traces light paths from the emitting triangles only and does not go with --env;"},
+      {"--method lt --env 1,1,1",
+       "--method lt traces light paths from the emitting triangles only and does not go with --env;"},
       {"--method lt --env-map /nonexistent/sky.exr", "does not go with --env-map; use mis"},
-      {"--method lt --adaptive", "--method lt traces light paths from the emitting triangles only and does not go with --adaptive"},
+      {"--method lt --adaptive",
+       "--method lt traces light paths from the emitting triangles only and does not go with --adaptive"},
       {"--method lt --aovs albedo,spp", "--method lt records no first surfaces, which --aovs 'albedo,spp' asks for"},
       {"--method lt --denoise", "--method lt records no first surfaces, which --denoise needs"},
       {"--method bdpt --adaptive", "--method bdpt does not go with --adaptive (its passes cover chosen pixels"},

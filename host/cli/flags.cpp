@@ -73,6 +73,8 @@ std::array<float, 3> parseVec3Flag(const std::string& flag, const std::string& t
       size_t used = 0;
       v[size_t(n)] = std::stof(item, &used);
       if (item.find_first_not_of(" \t", used) != std::string::npos) throw std::invalid_argument(item);
+    } catch (const std::out_of_range&) {
+      throw Error(flag + " '" + text + "': '" + item + "' is beyond the float range");
     } catch (const std::exception&) {
       throw Error(flag + " '" + text + "': '" + item + "' is not a number");
     }
