@@ -1,7 +1,9 @@
 #!/usr/bin/python3
-"""Error against time under an HDR environment map with a small, bright sun: pt, nee and mis.
+"""Error against time under an HDR environment map with a small, bright sun: pt, nee, mis, bdpt
+and vcm (lt traces no environment).
 
   bench/env_sun.py [--out bench/out/env-sun] [--width 192] [--height 144] [--max-spp 256] [--ref-spp 4096]
+                   [--methods pt,nee,mis,bdpt,vcm]
 
 Writes, into OUT:
   - sun-sky.exr: a 512x256 latitude-longitude map, a sky of radiance 0.4-1.0 (brighter
@@ -88,7 +90,7 @@ def main():
     benchlib.add_arguments(p, "--out", "--width", "--height", out=benchlib.scratch_path("env-sun"), width=192,
                            height=144)
     p.add_argument("--max-spp", type=int, default=256)
-    benchlib.add_arguments(p, "--ref-spp")
+    benchlib.add_arguments(p, "--ref-spp", "--methods", methods="pt,nee,mis,bdpt,vcm")
     args = p.parse_args()
     if not os.path.exists(BLOB):
         sys.exit(f"{BLOB} is missing: build first (cmake --build build)")
@@ -101,7 +103,7 @@ def main():
     scene = write_scene(folder)
     subprocess.run([sys.executable, os.path.join(benchlib.ROOT, "bench", "converge.py"), scene, "--out", args.out,
                     "--width", str(args.width), "--height", str(args.height), "--max-spp", str(args.max_spp),
-                    "--ref-spp", str(args.ref_spp), "--", "--env-map", env], check=True)
+                    "--ref-spp", str(args.ref_spp), "--methods", args.methods, "--", "--env-map", env], check=True)
     for ext in (".csv", ".png"):
         shutil.copy(os.path.join(args.out, "sun-blob" + ext), benchlib.results_path("convergence"))
 
