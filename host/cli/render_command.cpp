@@ -484,11 +484,10 @@ void warnIfDim(const Image& image, uint64_t passes, double target) {
 // Radiance past the float range has no value to write: a pixel summed to infinity would
 // pass for a bright one in a PNG and for the scene's answer in an EXR. No file is written.
 void refuseNonFiniteImage(const Image& image) {
-  size_t bad = 0, first = 0;
-  for (size_t i = 0; i < image.rgb.size(); ++i)
-    if (!std::isfinite(image.rgb[i]) && bad++ == 0) first = i / 3;
-  if (bad == 0) return;
-  throw Error(std::to_string(bad) + " pixel values of the image are past the float range (first at pixel (" +
+  const NonFiniteValues found = nonFiniteValues(image);
+  if (found.count == 0) return;
+  const size_t first = found.firstPixel;
+  throw Error(std::to_string(found.count) + " pixel values of the image are past the float range (first at pixel (" +
               std::to_string(first % size_t(image.width)) + ", " + std::to_string(first / size_t(image.width)) +
               ")): the emitters (Ke, --env, --env-map times --env-scale) are too bright for 32-bit floats; "
               "nothing written");

@@ -34,21 +34,28 @@ ImageError imageError(const Image& image, const Image& reference) {
   return e;
 }
 
-void requireFinite(const Image& image, const std::string& source) {
+NonFiniteValues nonFiniteValues(const Image& image) {
+  NonFiniteValues found;
   const size_t pixels = size_t(image.width) * size_t(image.height);
-  for (size_t p = 0; p < pixels && 3 * p + 2 < image.rgb.size(); ++p) {
-    const float* rgb = &image.rgb[3 * p];
-    if (std::isfinite(rgb[0]) && std::isfinite(rgb[1]) && std::isfinite(rgb[2])) continue;
-    std::string values;
-    for (int c = 0; c < 3; ++c) {
-      std::ostringstream v;
-      v << rgb[c];
-      values += (c ? " " : "") + v.str();
-    }
-    throw Error(source + ": pixel (" + std::to_string(p % size_t(image.width)) + ", " +
-                std::to_string(p / size_t(image.width)) + ") is not finite (" + values +
-                "); metrics need finite radiance everywhere");
+  for (size_t p = 0; p < pixels && 3 * p + 2 < image.rgb.size(); ++p)
+    for (int c = 0; c < 3; ++c)
+      if (!std::isfinite(image.rgb[3 * p + size_t(c)]) && found.count++ == 0) found.firstPixel = p;
+  return found;
+}
+
+void requireFinite(const Image& image, const std::string& source) {
+  const NonFiniteValues found = nonFiniteValues(image);
+  if (found.count == 0) return;
+  const size_t p = found.firstPixel;
+  std::string values;
+  for (int c = 0; c < 3; ++c) {
+    std::ostringstream v;
+    v << image.rgb[3 * p + size_t(c)];
+    values += (c ? " " : "") + v.str();
   }
+  throw Error(source + ": pixel (" + std::to_string(p % size_t(image.width)) + ", " +
+              std::to_string(p / size_t(image.width)) + ") is not finite (" + values +
+              "); metrics need finite radiance everywhere");
 }
 
 Image blockAverage(const Image& image, int k) {

@@ -3,6 +3,7 @@
 // mean absolute error, over linear radiance.
 #pragma once
 #include <array>
+#include <cstddef>
 #include <string>
 
 #include "image/image_io.h"
@@ -21,6 +22,13 @@ struct ImageError {
 
 // Throws fh::Error if the sizes differ.
 ImageError imageError(const Image& image, const Image& reference);
+
+// The image's channel values that are not finite: how many, and the first pixel (in rows
+// from the top) holding one, if any.
+struct NonFiniteValues {
+  size_t count = 0, firstPixel = 0;
+};
+NonFiniteValues nonFiniteValues(const Image& image);
 
 // Throws fh::Error, "SOURCE: pixel (x, y) ...", naming the first pixel (in rows from the top)
 // with a channel that is not finite: metrics over it would be NaN or infinite.
