@@ -392,15 +392,18 @@ TEST(EnvironmentMapCli, RendersFromExrAndHdrAndRejectsBadInput) {
   struct Bad {
     std::string args, message;
   };
-  for (const Bad& bad : std::vector<Bad>{
-           {"--env-map '" + dir + "/missing.exr'", "--env-map '" + dir + "/missing.exr': file not found"},
-           {"--env-map '" + dir + "/sky.png'", "must be an .exr or .hdr"},
-           {"--env-rotate 10", "--env-rotate applies to --env-map"},
-           {"--env-scale 2", "--env-scale applies to --env-map"},
-           {"--env 1,1,1 --env-map '" + dir + "/sky.exr'", "pick one"},
-           {"--env-map '" + dir + "/sky.exr' --env-scale -1", "--env-scale must be"},
-           {"--env-map '" + dir + "/sky.exr' --env-rotate nan", "--env-rotate"},
-           {"--env-map '" + dir + "/negative.exr'", "negative.exr: texel (2, 0) holds a negative"}}) {
+  for (const Bad& bad :
+       std::vector<Bad>{{"--env-map '" + dir + "/missing.exr'", "--env-map '" + dir + "/missing.exr': file not found"},
+                        {"--env-map '" + dir + "/sky.png'", "must be an .exr or .hdr"},
+                        {"--env-rotate 10", "--env-rotate applies to --env-map"},
+                        {"--env-scale 2", "--env-scale applies to --env-map"},
+                        {"--env 1,1,1 --env-map '" + dir + "/sky.exr'", "pick one"},
+                        {"--env-map '" + dir + "/sky.exr' --env-scale -1", "--env-scale must be"},
+                        {"--env-map '" + dir + "/sky.exr' --env-rotate nan", "--env-rotate"},
+                        // A map's texels up to 3.75: scaled by 1e38, texel (14, 0)'s 3.5 is the first past float.
+                        {"--env-map '" + dir + "/sky.exr' --env-scale 1e38",
+                         "sky.exr: texel (14, 0) is past the float range once multiplied by --env-scale 1e+38"},
+                        {"--env-map '" + dir + "/negative.exr'", "negative.exr: texel (2, 0) holds a negative"}}) {
     const auto r = test::runFredholm(base + "-o '" + dir + "/bad.exr' " + bad.args);
     EXPECT_NE(r.exitCode, 0) << bad.args;
     EXPECT_NE(r.output.find("fredholm: error: "), std::string::npos) << r.output;

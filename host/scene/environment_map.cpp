@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
+#include <string>
 
 #include "base/error.h"
 #include "image/image_io.h"
@@ -11,6 +13,12 @@ namespace fh {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+
+std::string shortNumber(float v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
 
 double luminance(const float* rgb) { return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]; }
 
@@ -71,6 +79,9 @@ EnvironmentMap makeEnvironmentMap(const std::string& source, int width, int heig
           throw Error(source + ": texel (" + std::to_string(x) + ", " + std::to_string(y) +
                       ") holds a negative or non-finite radiance");
         map.texels[4 * i + c] = v * scale;
+        if (!std::isfinite(map.texels[4 * i + c]))
+          throw Error(source + ": texel (" + std::to_string(x) + ", " + std::to_string(y) +
+                      ") is past the float range " + "once multiplied by --env-scale " + shortNumber(scale));
       }
       weights[size_t(x)] = weightOf(i, y);
       rowTotal += weights[size_t(x)];
